@@ -1,10 +1,10 @@
 // ctlio_demo: a first end-to-end run. Fits a pose on the SE(3) manifold to
 // noisy point correspondences with Ceres and prints the error before and after.
-#include <random>
-
 #include <ceres/ceres.h>
 #include <gflags/gflags.h>
 #include <glog/logging.h>
+
+#include <random>
 
 #include "ctlio/manifolds/pose_manifold.h"
 

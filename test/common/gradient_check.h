@@ -3,13 +3,13 @@
 // compares J_ambient·PlusJacobian with central differences through Plus).
 #pragma once
 
-#include <random>
-#include <string>
-#include <vector>
-
 #include <ceres/gradient_checker.h>
 #include <ceres/manifold.h>
 #include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
 
 #include "ctlio/manifolds/pose_manifold.h"
 

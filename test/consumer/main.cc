@@ -1,8 +1,8 @@
 // Uses the installed ctlio package from another project: one pose on the
 // PoseManifold, fitted in a Ceres problem; exits non-zero on failure.
-#include <cstdio>
-
 #include <ceres/ceres.h>
+
+#include <cstdio>
 
 #include "ctlio/manifolds/pose_manifold.h"
 

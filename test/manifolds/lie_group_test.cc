@@ -1,8 +1,8 @@
 // SO(3)/SE(3) module: identities to machine precision, near φ = 0 and |φ| = π.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "ctlio/manifolds/se3.h"
 
@@ -21,11 +21,16 @@ Vec3 RandomUnit(std::mt19937& rng) {
 double SampleAngle(std::mt19937& rng, int i) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   switch (i % 5) {
-    case 0: return std::pow(10.0, -12.0 + 11.0 * u(rng));             // 1e-12 … 0.1
-    case 1: return so3::kSmallAngle * (1.0 + 0.02 * (u(rng) - 0.5));  // series switch
-    case 2: return kPi * u(rng);
-    case 3: return kPi - 1e-6 * u(rng);                               // |φ| near π
-    default: return kPi - std::pow(10.0, -9.0 + 8.0 * u(rng));
+    case 0:
+      return std::pow(10.0, -12.0 + 11.0 * u(rng));  // 1e-12 … 0.1
+    case 1:
+      return so3::kSmallAngle * (1.0 + 0.02 * (u(rng) - 0.5));  // series switch
+    case 2:
+      return kPi * u(rng);
+    case 3:
+      return kPi - 1e-6 * u(rng);  // |φ| near π
+    default:
+      return kPi - std::pow(10.0, -9.0 + 8.0 * u(rng));
   }
 }
 
@@ -87,7 +92,9 @@ TEST(Jacobians, LeftJacobianTimesInverseIsIdentity) {
   for (int i = 0; i < 5000; ++i) {
     const Vec6 xi = SampleTwist(rng, i);
     EXPECT_LT((so3::LeftJacobian(xi.tail<3>()) * so3::LeftJacobianInverse(xi.tail<3>()) -
-               Mat3::Identity()).norm(), 1e-10);
+               Mat3::Identity())
+                  .norm(),
+              1e-10);
     EXPECT_LT((se3::LeftJacobian(xi) * se3::LeftJacobianInverse(xi) - Mat6::Identity()).norm(),
               1e-10);
     EXPECT_TRUE(se3::LeftJacobianInverse(xi).allFinite());
@@ -105,8 +112,8 @@ TEST(Jacobians, LeftJacobianMatchesCentralDifferences) {
     Mat6 numeric;
     for (int k = 0; k < 6; ++k) {
       const Vec6 e = Vec6::Unit(k) * h;
-      numeric.col(k) = ((SE3::Exp(xi + e) * T_inv).Log() - (SE3::Exp(xi - e) * T_inv).Log()) /
-                       (2.0 * h);
+      numeric.col(k) =
+          ((SE3::Exp(xi + e) * T_inv).Log() - (SE3::Exp(xi - e) * T_inv).Log()) / (2.0 * h);
     }
     EXPECT_LT((numeric - se3::LeftJacobian(xi)).norm(), 1e-7 * std::max(1.0, xi.norm()))
         << xi.transpose();
@@ -124,8 +131,7 @@ TEST(Jacobians, SeriesAndClosedFormAgreeAcrossTheSwitch) {
     EXPECT_NEAR(k.b, static_cast<double>((1.0L - c) / t2), 2e-16) << theta;
     EXPECT_NEAR(k.c, static_cast<double>((t - s) / (t2 * t)), 2e-16) << theta;
     const long double d = (1.0L - 0.5L * t / std::tan(0.5L * t)) / t2;
-    EXPECT_NEAR(so3::LeftJacobianInverseCoefficient(theta * theta), static_cast<double>(d),
-                5e-16)
+    EXPECT_NEAR(so3::LeftJacobianInverseCoefficient(theta * theta), static_cast<double>(d), 5e-16)
         << theta;
     // The SE(3) Q block, with ρ and φ of comparable size, against its closed form.
     const long double c2 = (t2 + 2.0L * c - 2.0L) / (2.0L * t2 * t2);
@@ -134,7 +140,8 @@ TEST(Jacobians, SeriesAndClosedFormAgreeAcrossTheSwitch) {
     xi.head<3>() = Vec3(0.3, -0.2, 0.4);
     xi.tail<3>() = theta * Vec3(1.0, 2.0, -2.0) / 3.0;
     const Mat3 P = so3::Hat(xi.tail<3>()), R = so3::Hat(xi.head<3>());
-    const Mat3 expected = 0.5 * R + static_cast<double>((t - s) / (t2 * t)) * (P * R + R * P + P * R * P) +
+    const Mat3 expected = 0.5 * R +
+                          static_cast<double>((t - s) / (t2 * t)) * (P * R + R * P + P * R * P) +
                           static_cast<double>(c2) * (P * P * R + R * P * P - 3.0 * P * R * P) +
                           static_cast<double>(c3) * (P * R * P * P + P * P * R * P);
     EXPECT_LT((se3::LeftJacobianQ(xi) - expected).cwiseAbs().maxCoeff(), 3e-16) << theta;

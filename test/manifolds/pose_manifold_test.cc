@@ -1,14 +1,15 @@
 // PoseManifold and RotationManifold: Ceres' manifold invariants at random and
 // near-singular points, and the lift used by every cost function on a pose.
-#include <cmath>
-#include <random>
+#include "ctlio/manifolds/pose_manifold.h"
 
 #include <ceres/ceres.h>
 #include <ceres/manifold_test_utils.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "common/gradient_check.h"
-#include "ctlio/manifolds/pose_manifold.h"
 
 namespace ctlio {
 namespace {
@@ -56,13 +57,12 @@ TEST_P(PoseManifoldInvariants, Hold) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RandomAndNearSingular, PoseManifoldInvariants,
-    ::testing::Values(Case{1.0, 2.0, 0.5},            // generic
-                      Case{0.0, 1e-9, 1e-9},          // identity, tiny steps
-                      Case{1e-7, 0.3, 1e-12},         // small angles
-                      Case{kPi - 1e-7, 2.5, 0.2},     // x near π
-                      Case{3.0, kPi - 1e-3, 1.5}));  // large steps
+INSTANTIATE_TEST_SUITE_P(RandomAndNearSingular, PoseManifoldInvariants,
+                         ::testing::Values(Case{1.0, 2.0, 0.5},           // generic
+                                           Case{0.0, 1e-9, 1e-9},         // identity, tiny steps
+                                           Case{1e-7, 0.3, 1e-12},        // small angles
+                                           Case{kPi - 1e-7, 2.5, 0.2},    // x near π
+                                           Case{3.0, kPi - 1e-3, 1.5}));  // large steps
 
 class RotationManifoldInvariants : public ::testing::TestWithParam<Case> {};
 
@@ -85,8 +85,7 @@ TEST_P(RotationManifoldInvariants, Hold) {
 
 INSTANTIATE_TEST_SUITE_P(RandomAndNearSingular, RotationManifoldInvariants,
                          ::testing::Values(Case{1.0, 2.0, 0.5}, Case{0.0, 1e-9, 1e-9},
-                                           Case{kPi - 1e-7, 2.5, 0.2},
-                                           Case{3.0, kPi - 1e-3, 1.5}));
+                                           Case{kPi - 1e-7, 2.5, 0.2}, Case{3.0, kPi - 1e-3, 1.5}));
 
 TEST(PoseManifold, PlusIsLeftPerturbationAndMinusIgnoresQuaternionSign) {
   const SE3 T = SE3::Exp((Vec6() << 1, 2, 3, 0.3, -0.4, 1.0).finished());

@@ -7,10 +7,9 @@
 // θ = π (Log never returns θ > π).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
-
-#include <Eigen/Geometry>
 
 #include "ctlio/manifolds/types.h"
 
@@ -44,13 +43,15 @@ struct RodriguesCoefficients {
   explicit RodriguesCoefficients(double theta2) {
     if (theta2 < kSmallAngle * kSmallAngle) {
       // Σ(−1)ⁿθ²ⁿ/(2n+1)!, Σ(−1)ⁿθ²ⁿ/(2n+2)!, Σ(−1)ⁿθ²ⁿ/(2n+3)!.
-      constexpr double ka[] = {1.0, -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880,
-                               -1.0 / 39916800, 1.0 / 6227020800, -1.0 / 1307674368000};
-      constexpr double kb[] = {1.0 / 2, -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800,
-                               -1.0 / 479001600, 1.0 / 87178291200, -1.0 / 20922789888000};
-      constexpr double kc[] = {1.0 / 6, -1.0 / 120, 1.0 / 5040, -1.0 / 362880,
-                               1.0 / 39916800, -1.0 / 6227020800, 1.0 / 1307674368000,
-                               -1.0 / 355687428096000};
+      constexpr double ka[] = {
+          1.0,          -1.0 / 6,        1.0 / 120,        -1.0 / 5040,
+          1.0 / 362880, -1.0 / 39916800, 1.0 / 6227020800, -1.0 / 1307674368000};
+      constexpr double kb[] = {
+          1.0 / 2,       -1.0 / 24,        1.0 / 720,         -1.0 / 40320,
+          1.0 / 3628800, -1.0 / 479001600, 1.0 / 87178291200, -1.0 / 20922789888000};
+      constexpr double kc[] = {
+          1.0 / 6,        -1.0 / 120,        1.0 / 5040,          -1.0 / 362880,
+          1.0 / 39916800, -1.0 / 6227020800, 1.0 / 1307674368000, -1.0 / 355687428096000};
       a = Series(theta2, ka);
       b = Series(theta2, kb);
       c = Series(theta2, kc);
