@@ -1,0 +1,67 @@
+// Point-cloud files: PCD (incl. the Ouster fields of the Newer College Dataset 2020), PLY and
+// KITTI-style float32 .bin scans with an optional per-point time file (SPEC §6, §7).
+//
+// One plain struct for every format. Times follow SPEC §1: int64 nanoseconds in I/O. A cloud
+// carries its stamp (the scan start) and, when the file has a time field, the ABSOLUTE time of
+// each point (stamp_ns + offset). Every reader throws std::runtime_error naming the file (and the
+// header line or point index where it applies) on bad input; nothing is silently dropped except
+// non-finite points, which are removed and counted in `dropped_non_finite`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ctlio/manifolds/types.h"
+
+namespace ctlio::io {
+
+struct PointCloud {
+  int64_t stamp_ns = 0;           // scan start (the Newer College file-name stamp)
+  std::vector<Vec3> points;       // sensor frame, metres
+  std::vector<int64_t> times_ns;  // absolute per-point times; empty if the file has none
+  std::vector<float> intensity;   // optional (empty if absent)
+  std::vector<uint16_t> ring;     // optional beam index (empty if absent)
+  size_t dropped_non_finite = 0;  // points removed because x, y or z was NaN/inf
+
+  size_t size() const { return points.size(); }
+  bool has_times() const { return !times_ns.empty(); }
+  // Per-point time relative to the stamp, in seconds (what a deskewing front end wants).
+  double RelativeTime(size_t i) const { return 1e-9 * double(times_ns[i] - stamp_ns); }
+};
+
+// Which per-point time field the readers accept, in order of preference:
+//   "t"         uint32 (or any integer type): nanoseconds since the scan stamp (Ouster driver);
+//   "time"      float/double: seconds since the scan stamp (Velodyne/Hesai drivers);
+//   "timestamp" double: ABSOLUTE seconds (Livox/Hesai); converted to ns.
+struct ReadOptions {
+  int64_t stamp_ns = 0;  // the scan stamp (PCD/PLY carry none; Newer College has it in the name)
+  bool require_time = false;  // throw if the file has no per-point time field
+};
+
+// PCD (ascii, binary, binary_compressed) through PCL.
+PointCloud ReadPcd(const std::string& path, const ReadOptions& options = {});
+// PLY (ascii or binary) through PCL; same fields as PCD.
+PointCloud ReadPly(const std::string& path, const ReadOptions& options = {});
+// Dispatch on the extension (.pcd, .ply, .bin).
+PointCloud ReadPointCloud(const std::string& path, const ReadOptions& options = {});
+
+// KITTI-style scan: little-endian float32 records of `floats_per_point` values (4 = x y z
+// reflectance as in KITTI; 3 = x y z as in gtsam_points' dumps). If `times_path` is non-empty it is
+// read as one float32 per point, seconds since the stamp (gtsam_points' times_*.bin), and must have
+// exactly one value per point.
+PointCloud ReadKittiBin(const std::string& path, int floats_per_point = 4,
+                        const std::string& times_path = "", int64_t stamp_ns = 0);
+
+// Writers. WritePcd writes binary PCD with the Ouster OS1 fields of the Newer College Dataset:
+// x y z intensity (float32), t (uint32 ns since stamp), reflectivity (uint16), ring (uint8),
+// noise (uint16), range (uint32, mm). Clouds without times get t = 0.
+void WritePcd(const std::string& path, const PointCloud& cloud);
+// Binary little-endian PLY with x y z (float) and, when present, t (uint32 ns since stamp).
+void WritePly(const std::string& path, const PointCloud& cloud);
+// KITTI .bin (x y z reflectance float32); if `times_path` is non-empty, float32 seconds since
+// stamp.
+void WriteKittiBin(const std::string& path, const PointCloud& cloud,
+                   const std::string& times_path = "");
+
+}  // namespace ctlio::io
