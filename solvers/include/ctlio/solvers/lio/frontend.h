@@ -1,0 +1,91 @@
+// Lidar front end (SPEC §4, as in CT-ICP and the reference implementation): range gate, voxel
+// subsampling, keypoint selection, and the association of a point with a plane of the voxel map
+// (k nearest neighbours, PCA plane, planarity weight, distance gate).
+#pragma once
+
+#include <vector>
+
+#include "ctlio/factors/lidar/point_to_plane.h"
+#include "ctlio/manifolds/types.h"
+#include "ctlio/solvers/lio/lidar_frontend_options.h"
+#include "ctlio/solvers/lio/voxel_map.h"
+
+namespace ctlio::lio {
+
+// One lidar return: position in the sensor/robot frame and time in seconds (relative to any
+// origin the caller chooses, the same as the knot times it registers against).
+struct TimedPoint {
+  Vec3 point = Vec3::Zero();
+  double time = 0.0;
+};
+
+// Keeps the points with min_range ≤ |p| ≤ max_range (and finite), in their order.
+std::vector<TimedPoint> RangeGate(const std::vector<TimedPoint>& points, double min_range,
+                                  double max_range);
+
+// One point per cubic voxel of the given size: the first one met, so the output keeps the input
+// order and every kept point is a real return with its own time (an average would mix times).
+// Hash based (open addressing on packed 21-bit voxel coordinates), O(n).
+std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points,
+                                           double voxel_size);
+
+// The plane through a point's neighbours.
+struct PlaneFit {
+  Vec3 centroid = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();  // unit, eigenvector of the smallest covariance eigenvalue
+  // σ1 ≥ σ2 ≥ σ3: square roots of the covariance eigenvalues.
+  double sigma1 = 0.0, sigma2 = 0.0, sigma3 = 0.0;
+  // ((σ2 − σ3)/σ1)² (SPEC §4): ≈1 for a clean plane, ≈0 for a line or an isotropic blob.
+  double planarity_weight = 0.0;
+};
+
+// PCA of the neighbours; false for fewer than three points or a degenerate (zero-spread) set.
+bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane);
+
+// Associates map-frame points with planes of a voxel map. Holds its neighbour buffer, so use
+// one per thread.
+class PlaneAssociator {
+ public:
+  PlaneAssociator(const VoxelMap& map, const LidarFrontendOptions& options);
+
+  // For q (robot frame) observed at p_map = T_mr q: ≥ min_neighbours of ≤ max_neighbours nearest
+  // map points (±1 voxel), a PCA plane through their centroid (less noisy than the nearest point
+  // alone) and |nᵀ(p_map − centroid)| ≤ max_plane_distance. Fills *association (weight = the
+  // planarity weight) and returns true on success.
+  bool Associate(const Vec3& q_robot, const Vec3& p_map, PlaneAssociation* association);
+
+ private:
+  const VoxelMap& map_;
+  LidarFrontendOptions options_;
+  std::vector<VoxelMap::Neighbour> neighbours_;
+};
+
+// Per-sweep preprocessing with the scan counter of the SPEC (finer subsampling for the first
+// scans), and the voxel-map options of the front-end options.
+class LidarFrontend {
+ public:
+  explicit LidarFrontend(const LidarFrontendOptions& options);
+
+  // Range gate + subsampling (voxel_size, or initial_voxel_size for the first initial_scans
+  // sweeps). Advances the scan counter.
+  std::vector<TimedPoint> Preprocess(const std::vector<TimedPoint>& sweep);
+  // One keypoint per keypoint_voxel_size voxel of a preprocessed sweep.
+  std::vector<TimedPoint> Keypoints(const std::vector<TimedPoint>& preprocessed) const;
+
+  // Inserts map-frame points and drops the voxels far from the robot position.
+  void UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map);
+
+  const VoxelMap& map() const { return map_; }
+  VoxelMap& map() { return map_; }
+  const LidarFrontendOptions& options() const { return options_; }
+  int num_scans() const { return num_scans_; }
+
+  static VoxelMap::Options MapOptions(const LidarFrontendOptions& options);
+
+ private:
+  LidarFrontendOptions options_;
+  VoxelMap map_;
+  int num_scans_ = 0;
+};
+
+}  // namespace ctlio::lio

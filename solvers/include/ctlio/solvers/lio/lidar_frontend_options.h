@@ -1,0 +1,60 @@
+// Parameters of the lidar front end (SPEC §4), with the defaults of CT-ICP / the reference
+// implementation. data/lidar_frontend.yaml documents every key; LoadLidarFrontendOptions reads
+// it. Units: metres, seconds.
+#pragma once
+
+#include <string>
+
+namespace YAML {
+class Node;
+}
+
+namespace ctlio::lio {
+
+struct LidarFrontendOptions {
+  // Range gate: points closer than min_range (the robot itself) or farther than max_range are
+  // dropped before anything else.
+  double min_range = 1.0;
+  double max_range = 100.0;
+
+  // Voxel-grid subsampling of each sweep (one point per voxel); finer for the first scans while
+  // the map is still sparse.
+  double voxel_size = 0.5;
+  double initial_voxel_size = 0.2;
+  int initial_scans = 20;
+
+  // Keypoints: one per keypoint_voxel_size voxel of the subsampled sweep.
+  double keypoint_voxel_size = 1.0;
+
+  // Voxel hash map.
+  double map_voxel_size = 1.0;
+  int max_points_per_voxel = 20;
+  double min_point_distance = 0.1;  // minimum spacing of the points in one voxel
+  double max_map_distance = 400.0;  // voxels farther than this from the robot are removed
+
+  // Association: k nearest neighbours from the ±1 voxels, PCA plane, gate on the point-to-plane
+  // distance.
+  int max_neighbours = 20;
+  int min_neighbours = 10;
+  double max_plane_distance = 1.0;
+
+  // Registration: re-association rounds, solver iterations per round, robust loss.
+  int max_iterations = 10;
+  int solver_iterations = 5;
+  std::string loss = "cauchy";  // "cauchy", "huber" or "none"
+  double loss_scale = 0.2;      // metres (applied to the weighted residual)
+  // Stop re-associating when the knots' poses move less than this between rounds.
+  double convergence_translation = 1e-3;  // m
+  double convergence_rotation = 1e-4;     // rad
+
+  // Throws std::invalid_argument naming the first bad field.
+  void Validate() const;
+};
+
+// Reads the options from a YAML mapping; keys not present keep their defaults; unknown keys and
+// ill-typed values throw std::runtime_error naming `source` and the line.
+LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
+                                                  const std::string& source = "<yaml>");
+LidarFrontendOptions LoadLidarFrontendOptions(const std::string& path);
+
+}  // namespace ctlio::lio

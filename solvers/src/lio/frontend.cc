@@ -1,0 +1,156 @@
+#include "ctlio/solvers/lio/frontend.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+namespace ctlio::lio {
+
+std::vector<TimedPoint> RangeGate(const std::vector<TimedPoint>& points, double min_range,
+                                  double max_range) {
+  std::vector<TimedPoint> out;
+  out.reserve(points.size());
+  const double min2 = min_range * min_range, max2 = max_range * max_range;
+  for (const TimedPoint& p : points) {
+    const double r2 = p.point.squaredNorm();
+    if (std::isfinite(r2) && std::isfinite(p.time) && r2 >= min2 && r2 <= max2) out.push_back(p);
+  }
+  return out;
+}
+
+namespace {
+
+// 21 bits per axis around an offset of 2²⁰ voxels: ±1,048,576 voxels (±210 km at 0.2 m).
+constexpr int64_t kKeyOffset = int64_t{1} << 20;
+constexpr int64_t kKeyRange = int64_t{1} << 21;
+constexpr uint64_t kEmpty = ~uint64_t{0};
+
+inline bool PackedKey(const Vec3& p, double inverse_size, uint64_t* key) {
+  const double fx = std::floor(p.x() * inverse_size), fy = std::floor(p.y() * inverse_size),
+               fz = std::floor(p.z() * inverse_size);
+  const double lo = -static_cast<double>(kKeyOffset), hi = static_cast<double>(kKeyOffset - 1);
+  if (!(fx >= lo && fx <= hi && fy >= lo && fy <= hi && fz >= lo && fz <= hi)) return false;
+  const uint64_t x = static_cast<uint64_t>(static_cast<int64_t>(fx) + kKeyOffset);
+  const uint64_t y = static_cast<uint64_t>(static_cast<int64_t>(fy) + kKeyOffset);
+  const uint64_t z = static_cast<uint64_t>(static_cast<int64_t>(fz) + kKeyOffset);
+  static_assert(3 * 21 < 64, "packed key must not collide with kEmpty");
+  *key = (x * static_cast<uint64_t>(kKeyRange) + y) * static_cast<uint64_t>(kKeyRange) + z;
+  return true;
+}
+
+inline uint64_t Mix(uint64_t k) {  // splitmix64 finaliser
+  k ^= k >> 30;
+  k *= 0xbf58476d1ce4e5b9ull;
+  k ^= k >> 27;
+  k *= 0x94d049bb133111ebull;
+  k ^= k >> 31;
+  return k;
+}
+
+}  // namespace
+
+std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points,
+                                           double voxel_size) {
+  if (!(voxel_size > 0.0)) throw std::invalid_argument("VoxelGridSubsample: voxel_size <= 0");
+  std::vector<TimedPoint> out;
+  if (points.empty()) return out;
+  size_t capacity = 16;
+  while (capacity < 2 * points.size()) capacity <<= 1;
+  std::vector<uint64_t> table(capacity, kEmpty);
+  const uint64_t mask = capacity - 1;
+  const double inverse_size = 1.0 / voxel_size;
+  for (const TimedPoint& p : points) {
+    uint64_t key;
+    if (!PackedKey(p.point, inverse_size, &key)) continue;  // non-finite or absurdly far
+    for (uint64_t slot = Mix(key) & mask;; slot = (slot + 1) & mask) {
+      if (table[slot] == key) break;
+      if (table[slot] == kEmpty) {
+        table[slot] = key;
+        out.push_back(p);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
+  const size_t n = neighbours.size();
+  if (n < 3) return false;
+  Vec3 mean = Vec3::Zero();
+  for (const auto& nb : neighbours) mean += nb.point;
+  mean /= static_cast<double>(n);
+  Mat3 cov = Mat3::Zero();
+  for (const auto& nb : neighbours) {
+    const Vec3 d = nb.point - mean;
+    cov.noalias() += d * d.transpose();
+  }
+  cov /= static_cast<double>(n);
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  if (es.info() != Eigen::Success) return false;
+  // Eigenvalues ascending: λ0 ≤ λ1 ≤ λ2, σ1 = √λ2 ≥ σ2 = √λ1 ≥ σ3 = √λ0.
+  const Vec3 lambda = es.eigenvalues().cwiseMax(0.0);
+  plane->sigma1 = std::sqrt(lambda[2]);
+  plane->sigma2 = std::sqrt(lambda[1]);
+  plane->sigma3 = std::sqrt(lambda[0]);
+  if (!(plane->sigma1 > 0.0)) return false;
+  const double a2d = (plane->sigma2 - plane->sigma3) / plane->sigma1;
+  plane->planarity_weight = a2d * a2d;
+  plane->centroid = mean;
+  plane->normal = es.eigenvectors().col(0).normalized();
+  return true;
+}
+
+PlaneAssociator::PlaneAssociator(const VoxelMap& map, const LidarFrontendOptions& options)
+    : map_(map), options_(options) {
+  neighbours_.reserve(options.max_neighbours);
+}
+
+bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
+                                PlaneAssociation* association) {
+  const int found = map_.KNearest(p_map, options_.max_neighbours, &neighbours_);
+  if (found < options_.min_neighbours) return false;
+  PlaneFit plane;
+  if (!FitPlane(neighbours_, &plane)) return false;
+  const double distance = std::abs(plane.normal.dot(p_map - plane.centroid));
+  if (!(distance <= options_.max_plane_distance)) return false;
+  association->point_robot = q_robot;
+  association->plane_point = plane.centroid;
+  association->plane_normal = plane.normal;
+  association->weight = plane.planarity_weight;
+  return true;
+}
+
+VoxelMap::Options LidarFrontend::MapOptions(const LidarFrontendOptions& options) {
+  VoxelMap::Options m;
+  m.voxel_size = options.map_voxel_size;
+  m.max_points_per_voxel = options.max_points_per_voxel;
+  m.min_point_distance = options.min_point_distance;
+  m.max_distance = options.max_map_distance;
+  return m;
+}
+
+LidarFrontend::LidarFrontend(const LidarFrontendOptions& options)
+    : options_(options), map_(MapOptions(options)) {
+  options_.Validate();
+}
+
+std::vector<TimedPoint> LidarFrontend::Preprocess(const std::vector<TimedPoint>& sweep) {
+  const double size =
+      num_scans_ < options_.initial_scans ? options_.initial_voxel_size : options_.voxel_size;
+  ++num_scans_;
+  return VoxelGridSubsample(RangeGate(sweep, options_.min_range, options_.max_range), size);
+}
+
+std::vector<TimedPoint> LidarFrontend::Keypoints(
+    const std::vector<TimedPoint>& preprocessed) const {
+  return VoxelGridSubsample(preprocessed, options_.keypoint_voxel_size);
+}
+
+void LidarFrontend::UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map) {
+  map_.Insert(points_map);
+  map_.RemoveFar(robot_position_map);
+}
+
+}  // namespace ctlio::lio

@@ -1,0 +1,92 @@
+#include "ctlio/solvers/lio/voxel_map.h"
+
+#include <stdexcept>
+
+namespace ctlio::lio {
+
+VoxelMap::VoxelMap(const Options& options)
+    : options_(options),
+      inverse_voxel_size_(1.0 / options.voxel_size),
+      min_distance2_(options.min_point_distance * options.min_point_distance) {
+  if (!(options.voxel_size > 0.0) || options.max_points_per_voxel < 1 ||
+      !(options.min_point_distance >= 0.0) || !(options.max_distance > 0.0)) {
+    throw std::invalid_argument(
+        "VoxelMap: need voxel_size > 0, max_points_per_voxel >= 1, min_point_distance >= 0, "
+        "max_distance > 0");
+  }
+}
+
+bool VoxelMap::Insert(const Vec3& p) {
+  if (!p.allFinite()) return false;
+  Voxel& voxel = voxels_[VoxelKeyOf(p, inverse_voxel_size_)];
+  if (static_cast<int>(voxel.points.size()) >= options_.max_points_per_voxel) return false;
+  for (const Vec3& existing : voxel.points) {
+    if ((existing - p).squaredNorm() < min_distance2_) return false;
+  }
+  if (voxel.points.empty()) voxel.points.reserve(options_.max_points_per_voxel);
+  voxel.points.push_back(p);
+  ++num_points_;
+  return true;
+}
+
+size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
+  size_t kept = 0;
+  for (const Vec3& p : points) kept += Insert(p) ? 1 : 0;
+  return kept;
+}
+
+size_t VoxelMap::RemoveFar(const Vec3& location) {
+  const double max2 = options_.max_distance * options_.max_distance;
+  size_t removed = 0;
+  for (auto it = voxels_.begin(); it != voxels_.end();) {
+    const Vec3 centre =
+        (Vec3(it->first.x, it->first.y, it->first.z) + Vec3::Constant(0.5)) * options_.voxel_size;
+    if ((centre - location).squaredNorm() > max2) {
+      num_points_ -= it->second.points.size();
+      it = voxels_.erase(it);
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  return removed;
+}
+
+int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
+                       double max_distance) const {
+  out->clear();
+  if (k <= 0) return 0;
+  if (out->capacity() < static_cast<size_t>(k)) out->reserve(k);
+  const double max2 = max_distance * max_distance;
+  const VoxelKey c = VoxelKeyOf(q, inverse_voxel_size_);
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const auto it = voxels_.find({c.x + dx, c.y + dy, c.z + dz});
+        if (it == voxels_.end()) continue;
+        for (const Vec3& p : it->second.points) {
+          const double d2 = (p - q).squaredNorm();
+          if (d2 > max2) continue;
+          const int n = static_cast<int>(out->size());
+          if (n == k && d2 >= out->back().squared_distance) continue;
+          // Insertion into the sorted list (k ≤ a few tens: cheaper than a heap).
+          if (n < k) out->push_back({p, d2});
+          int i = static_cast<int>(out->size()) - 1;
+          while (i > 0 && (*out)[i - 1].squared_distance > d2) {
+            (*out)[i] = (*out)[i - 1];
+            --i;
+          }
+          (*out)[i] = {p, d2};
+        }
+      }
+    }
+  }
+  return static_cast<int>(out->size());
+}
+
+void VoxelMap::Clear() {
+  voxels_.clear();
+  num_points_ = 0;
+}
+
+}  // namespace ctlio::lio

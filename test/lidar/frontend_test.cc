@@ -1,0 +1,194 @@
+// Lidar front end (SPEC §4): range gate, voxel subsampling, plane fit and its planarity weight,
+// association gate, and the YAML options.
+#include "ctlio/solvers/lio/frontend.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <random>
+#include <tuple>
+
+#include "ctlio/solvers/lio/lidar_frontend_options.h"
+
+namespace ctlio::lio {
+namespace {
+
+std::vector<TimedPoint> RandomSweep(std::mt19937& rng, int n, double half_extent) {
+  std::uniform_real_distribution<double> u(-half_extent, half_extent);
+  std::vector<TimedPoint> pts(n);
+  for (int i = 0; i < n; ++i) pts[i] = {Vec3(u(rng), u(rng), u(rng)), 1e-5 * i};
+  return pts;
+}
+
+TEST(Frontend, RangeGateKeepsExactlyTheBand) {
+  std::mt19937 rng(21);
+  auto pts = RandomSweep(rng, 5000, 20.0);
+  pts.push_back({Vec3(std::nan(""), 0, 0), 0.0});
+  const auto kept = RangeGate(pts, 2.0, 15.0);
+  size_t expected = 0;
+  for (const auto& p : pts) {
+    const double r = p.point.norm();
+    expected += (r >= 2.0 && r <= 15.0) ? 1 : 0;
+  }
+  EXPECT_EQ(kept.size(), expected);
+  for (const auto& p : kept) {
+    EXPECT_GE(p.point.norm(), 2.0);
+    EXPECT_LE(p.point.norm(), 15.0);
+  }
+  for (size_t i = 1; i < kept.size(); ++i) EXPECT_LT(kept[i - 1].time, kept[i].time);
+}
+
+// Reference: an ordered map of voxel keys, first point wins.
+TEST(Frontend, VoxelSubsampleKeepsFirstPointOfEveryVoxel) {
+  std::mt19937 rng(22);
+  const auto pts = RandomSweep(rng, 20000, 10.0);
+  for (double size : {0.2, 0.5, 1.0, 3.0}) {
+    std::map<std::tuple<int, int, int>, size_t> first;
+    std::vector<size_t> expected;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const VoxelKey k = VoxelKeyOf(pts[i].point, 1.0 / size);
+      if (first.emplace(std::make_tuple(k.x, k.y, k.z), i).second) expected.push_back(i);
+    }
+    const auto out = VoxelGridSubsample(pts, size);
+    ASSERT_EQ(out.size(), expected.size()) << size;
+    for (size_t j = 0; j < out.size(); ++j) {
+      EXPECT_EQ(out[j].point, pts[expected[j]].point);
+      EXPECT_EQ(out[j].time, pts[expected[j]].time);
+    }
+  }
+  EXPECT_TRUE(VoxelGridSubsample({}, 0.5).empty());
+  EXPECT_THROW(VoxelGridSubsample(pts, 0.0), std::invalid_argument);
+}
+
+std::vector<VoxelMap::Neighbour> Neighbours(const std::vector<Vec3>& pts) {
+  std::vector<VoxelMap::Neighbour> n;
+  for (const auto& p : pts) n.push_back({p, 0.0});
+  return n;
+}
+
+TEST(Frontend, PlaneFitRecoversNormalAndPlanarity) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  const Vec3 normal = Vec3(0.3, -0.5, 0.8).normalized();
+  const Vec3 e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+  const Vec3 origin(4.0, -2.0, 1.0);
+  std::vector<Vec3> plane, line, blob;
+  for (int i = 0; i < 20; ++i) {
+    plane.push_back(origin + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2 + noise(rng) * normal);
+    line.push_back(origin + 0.5 * u(rng) * e1 + noise(rng) * e2 + noise(rng) * normal);
+    blob.push_back(origin + 0.5 * Vec3(u(rng), u(rng), u(rng)));
+  }
+  PlaneFit fit;
+  ASSERT_TRUE(FitPlane(Neighbours(plane), &fit));
+  EXPECT_GT(std::abs(fit.normal.dot(normal)), 0.999);
+  EXPECT_NEAR(fit.normal.norm(), 1.0, 1e-12);
+  EXPECT_GT(fit.planarity_weight, 0.5);
+  EXPECT_GE(fit.sigma1, fit.sigma2);
+  EXPECT_GE(fit.sigma2, fit.sigma3);
+  const double a2d = (fit.sigma2 - fit.sigma3) / fit.sigma1;
+  EXPECT_DOUBLE_EQ(fit.planarity_weight, a2d * a2d);
+  ASSERT_TRUE(FitPlane(Neighbours(line), &fit));
+  EXPECT_LT(fit.planarity_weight, 0.01);
+  ASSERT_TRUE(FitPlane(Neighbours(blob), &fit));
+  EXPECT_LT(fit.planarity_weight, 0.3);
+  EXPECT_FALSE(FitPlane(Neighbours({origin, origin}), &fit));
+  EXPECT_FALSE(FitPlane(Neighbours({origin, origin, origin}), &fit));
+}
+
+TEST(Frontend, AssociationGate) {
+  LidarFrontendOptions options;
+  VoxelMap map(LidarFrontend::MapOptions(options));
+  // Map: the plane z = 0 sampled every 0.25 m (16 points per voxel, under the bound of 20).
+  for (double x = -5; x <= 5; x += 0.25)
+    for (double y = -5; y <= 5; y += 0.25) map.Insert(Vec3(x, y, 0.0));
+  PlaneAssociator associator(map, options);
+  PlaneAssociation a;
+  const Vec3 q(1.0, 2.0, 3.0);
+  ASSERT_TRUE(associator.Associate(q, Vec3(0.3, 0.2, 0.4), &a));
+  EXPECT_NEAR(std::abs(a.plane_normal.z()), 1.0, 1e-9);
+  EXPECT_NEAR(a.plane_point.z(), 0.0, 1e-12);
+  EXPECT_GT(a.weight, 0.8);
+  EXPECT_EQ(a.point_robot, q);
+  // 1.2 m above the plane: the ±1 voxel search still finds it, the 1.0 m gate must reject it.
+  EXPECT_FALSE(associator.Associate(q, Vec3(0.3, 0.2, 1.2), &a));
+  // Far from any map point: too few neighbours.
+  EXPECT_FALSE(associator.Associate(q, Vec3(0.3, 0.2, 2.5), &a));
+}
+
+TEST(Frontend, PreprocessUsesFineVoxelsForInitialScans) {
+  std::mt19937 rng(24);
+  LidarFrontendOptions options;
+  options.initial_scans = 1;
+  LidarFrontend frontend(options);
+  const auto sweep = RandomSweep(rng, 20000, 10.0);
+  const auto first = frontend.Preprocess(sweep);
+  const auto second = frontend.Preprocess(sweep);
+  EXPECT_EQ(first.size(), VoxelGridSubsample(RangeGate(sweep, 1.0, 100.0), 0.2).size());
+  EXPECT_EQ(second.size(), VoxelGridSubsample(RangeGate(sweep, 1.0, 100.0), 0.5).size());
+  EXPECT_LT(second.size(), first.size());
+  const auto keypoints = frontend.Keypoints(second);
+  EXPECT_EQ(keypoints.size(), VoxelGridSubsample(second, 1.0).size());
+  EXPECT_EQ(frontend.num_scans(), 2);
+}
+
+TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
+  const auto o =
+      LoadLidarFrontendOptions(std::string(CTLIO_SOURCE_DIR) + "/data/lidar_frontend.yaml");
+  const LidarFrontendOptions d;
+  EXPECT_EQ(o.min_range, d.min_range);
+  EXPECT_EQ(o.max_range, d.max_range);
+  EXPECT_EQ(o.voxel_size, 0.5);
+  EXPECT_EQ(o.initial_voxel_size, 0.2);
+  EXPECT_EQ(o.initial_scans, 20);
+  EXPECT_EQ(o.keypoint_voxel_size, 1.0);
+  EXPECT_EQ(o.map_voxel_size, 1.0);
+  EXPECT_EQ(o.max_points_per_voxel, 20);
+  EXPECT_EQ(o.min_point_distance, 0.1);
+  EXPECT_EQ(o.max_map_distance, 400.0);
+  EXPECT_EQ(o.max_neighbours, 20);
+  EXPECT_EQ(o.min_neighbours, 10);
+  EXPECT_EQ(o.max_plane_distance, 1.0);
+  EXPECT_EQ(o.max_iterations, 10);
+  EXPECT_EQ(o.solver_iterations, d.solver_iterations);
+  EXPECT_EQ(o.loss, d.loss);
+  EXPECT_EQ(o.loss_scale, d.loss_scale);
+  EXPECT_EQ(o.convergence_translation, d.convergence_translation);
+  EXPECT_EQ(o.convergence_rotation, d.convergence_rotation);
+}
+
+std::string ErrorOf(const std::string& yaml) {
+  try {
+    LidarFrontendOptionsFromYaml(YAML::Load(yaml), "test.yaml");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(FrontendOptions, BadInputNamesFileAndLine) {
+  EXPECT_EQ(ErrorOf("voxel_size: 0.3\nmax_neighbors: 20\n"),
+            "test.yaml:2: unknown lidar front-end key 'max_neighbors'");
+  EXPECT_EQ(ErrorOf("voxel_size: 0.3\nmin_neighbours: ten\n"),
+            "test.yaml:2: bad value for 'min_neighbours'");
+  EXPECT_NE(ErrorOf("min_neighbours: 30\n").find("max_neighbours"), std::string::npos);
+  EXPECT_NE(ErrorOf("loss: tukey\n").find("loss"), std::string::npos);
+  EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);
+  EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("voxel_size: 0.3\n")).voxel_size, 0.3);
+  EXPECT_THROW(LoadLidarFrontendOptions("/nonexistent/lidar.yaml"), std::runtime_error);
+  const std::string path = ::testing::TempDir() + "/lidar_frontend_bad.yaml";
+  std::ofstream(path) << "voxel_size: [0.3\n";
+  try {
+    LoadLidarFrontendOptions(path);
+    ADD_FAILURE() << "malformed YAML accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  std::ofstream(path) << "lidar_frontend:\n  voxel_size: 0.7\n";
+  EXPECT_EQ(LoadLidarFrontendOptions(path).voxel_size, 0.7);
+}
+
+}  // namespace
+}  // namespace ctlio::lio

@@ -1,0 +1,159 @@
+// Voxel hash map (SPEC §4): bounds per voxel, minimum spacing, far-voxel removal, and the
+// neighbour search against brute force.
+#include "ctlio/solvers/lio/voxel_map.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace ctlio::lio {
+namespace {
+
+std::vector<Vec3> RandomPoints(std::mt19937& rng, int n, double half_extent) {
+  std::uniform_real_distribution<double> u(-half_extent, half_extent);
+  std::vector<Vec3> pts(n);
+  for (auto& p : pts) p = Vec3(u(rng), u(rng), u(rng));
+  return pts;
+}
+
+std::vector<Vec3> AllPoints(const VoxelMap& map) {
+  std::vector<Vec3> all;
+  map.ForEachVoxel([&](const VoxelKey&, const std::vector<Vec3>& pts) {
+    all.insert(all.end(), pts.begin(), pts.end());
+  });
+  return all;
+}
+
+VoxelMap::Options DefaultOptions() { return VoxelMap::Options{}; }  // 1 m, 20, 0.1 m, 400 m
+
+TEST(VoxelMap, BoundsAndSpacingHold) {
+  std::mt19937 rng(11);
+  VoxelMap map(DefaultOptions());
+  // 60k points in a 6 m cube: ~280 per voxel offered, so the bounds must bite.
+  const auto pts = RandomPoints(rng, 60000, 3.0);
+  const size_t kept = map.Insert(pts);
+  EXPECT_EQ(kept, map.num_points());
+  EXPECT_LT(kept, pts.size());
+  size_t total = 0;
+  int full_voxels = 0;
+  map.ForEachVoxel([&](const VoxelKey& key, const std::vector<Vec3>& v) {
+    total += v.size();
+    EXPECT_LE(v.size(), 20u);
+    if (v.size() == 20u) ++full_voxels;
+    for (size_t i = 0; i < v.size(); ++i) {
+      const VoxelKey k = VoxelKeyOf(v[i], 1.0);
+      EXPECT_TRUE(k == key) << "point stored in the wrong voxel";
+      for (size_t j = i + 1; j < v.size(); ++j) EXPECT_GE((v[i] - v[j]).norm(), 0.1);
+    }
+  });
+  EXPECT_EQ(total, map.num_points());
+  EXPECT_EQ(map.num_voxels(), 216u);
+  EXPECT_GT(full_voxels, 200);
+}
+
+TEST(VoxelMap, RejectsClosePointsAndFullVoxels) {
+  VoxelMap::Options o;
+  o.max_points_per_voxel = 3;
+  VoxelMap map(o);
+  EXPECT_TRUE(map.Insert(Vec3(0.5, 0.5, 0.5)));
+  EXPECT_FALSE(map.Insert(Vec3(0.55, 0.5, 0.5)));  // 5 cm from an existing point
+  EXPECT_TRUE(map.Insert(Vec3(0.2, 0.5, 0.5)));
+  EXPECT_TRUE(map.Insert(Vec3(0.8, 0.5, 0.5)));
+  EXPECT_FALSE(map.Insert(Vec3(0.5, 0.1, 0.9)));  // voxel full
+  EXPECT_TRUE(map.Insert(Vec3(1.5, 0.5, 0.5)));   // next voxel
+  EXPECT_FALSE(map.Insert(Vec3(std::nan(""), 0.0, 0.0)));
+  EXPECT_EQ(map.num_points(), 4u);
+  EXPECT_EQ(map.num_voxels(), 2u);
+}
+
+TEST(VoxelMap, RemovesFarVoxelsOnly) {
+  std::mt19937 rng(12);
+  VoxelMap::Options o;
+  o.max_distance = 5.0;
+  VoxelMap map(o);
+  map.Insert(RandomPoints(rng, 20000, 10.0));
+  const size_t voxels_before = map.num_voxels();
+  const Vec3 location(2.0, -1.0, 0.5);
+  // Expected survivors: voxels whose centre is within 5 m.
+  size_t expected = 0, expected_points = 0;
+  map.ForEachVoxel([&](const VoxelKey& k, const std::vector<Vec3>& v) {
+    const Vec3 c = Vec3(k.x + 0.5, k.y + 0.5, k.z + 0.5);
+    if ((c - location).norm() <= 5.0) {
+      ++expected;
+      expected_points += v.size();
+    }
+  });
+  const size_t removed = map.RemoveFar(location);
+  EXPECT_EQ(removed, voxels_before - expected);
+  EXPECT_EQ(map.num_voxels(), expected);
+  EXPECT_EQ(map.num_points(), expected_points);
+  EXPECT_GT(removed, 0u);
+  map.ForEachVoxel([&](const VoxelKey& k, const std::vector<Vec3>&) {
+    EXPECT_LE((Vec3(k.x + 0.5, k.y + 0.5, k.z + 0.5) - location).norm(), 5.0);
+  });
+  EXPECT_EQ(AllPoints(map).size(), map.num_points());
+}
+
+// Within one voxel size of the query, the ±1-voxel search is exact: it must return exactly the
+// brute-force k nearest of all map points.
+TEST(VoxelMap, KNearestWithinOneVoxelEqualsBruteForce) {
+  std::mt19937 rng(13);
+  VoxelMap map(DefaultOptions());
+  map.Insert(RandomPoints(rng, 30000, 8.0));
+  const std::vector<Vec3> all = AllPoints(map);
+  std::vector<VoxelMap::Neighbour> out;
+  int nonempty = 0;
+  for (const Vec3& q : RandomPoints(rng, 300, 9.0)) {
+    for (int k : {1, 5, 20}) {
+      const int n = map.KNearest(q, k, &out, 1.0);
+      std::vector<double> d2;
+      for (const Vec3& p : all) {
+        const double d = (p - q).squaredNorm();
+        if (d <= 1.0) d2.push_back(d);
+      }
+      std::sort(d2.begin(), d2.end());
+      const int expected = std::min<int>(k, static_cast<int>(d2.size()));
+      ASSERT_EQ(n, expected);
+      ASSERT_EQ(static_cast<int>(out.size()), n);
+      for (int i = 0; i < n; ++i) {
+        EXPECT_DOUBLE_EQ(out[i].squared_distance, d2[i]);
+        EXPECT_DOUBLE_EQ((out[i].point - q).squaredNorm(), out[i].squared_distance);
+      }
+      nonempty += n > 0;
+    }
+  }
+  EXPECT_GT(nonempty, 500);
+}
+
+// Without a radius: the k nearest among all points of the 27 voxels around the query.
+TEST(VoxelMap, KNearestSearchesPlusMinusOneVoxel) {
+  std::mt19937 rng(14);
+  VoxelMap map(DefaultOptions());
+  map.Insert(RandomPoints(rng, 5000, 6.0));
+  const std::vector<Vec3> all = AllPoints(map);
+  std::vector<VoxelMap::Neighbour> out;
+  for (const Vec3& q : RandomPoints(rng, 200, 7.0)) {
+    const VoxelKey c = VoxelKeyOf(q, 1.0);
+    std::vector<double> d2;
+    for (const Vec3& p : all) {
+      const VoxelKey k = VoxelKeyOf(p, 1.0);
+      if (std::abs(k.x - c.x) <= 1 && std::abs(k.y - c.y) <= 1 && std::abs(k.z - c.z) <= 1) {
+        d2.push_back((p - q).squaredNorm());
+      }
+    }
+    std::sort(d2.begin(), d2.end());
+    const int n = map.KNearest(q, 20, &out);
+    ASSERT_EQ(n, std::min<int>(20, static_cast<int>(d2.size())));
+    for (int i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(out[i].squared_distance, d2[i]);
+  }
+}
+
+TEST(VoxelMap, RejectsBadOptions) {
+  VoxelMap::Options o;
+  o.voxel_size = 0.0;
+  EXPECT_THROW(VoxelMap{o}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ctlio::lio
