@@ -1,0 +1,61 @@
+// GP interpolation of the SE(3) state between two knots, and extrapolation past the last
+// knot (SPEC §2). The ONLY place that knows how a state between knots is formed: lidar and IMU
+// factors at a time τ hold a GpInterpolator and chain its Jacobians onto the knots.
+//
+//   Ω = Q(τ−t_k)Φ(t_{k+1}−τ)ᵀQ(T)⁻¹,  Λ = Φ(τ−t_k) − ΩΦ(T)   (per axis; Qc cancels)
+//   γ(τ) = Λγ_k + Ωγ_{k+1} = [ξ; ξ̇; ξ̈],  γ_k, γ_{k+1} from knot_state.h
+//   T(τ) = Exp(ξ)T_k,  ϖ(τ) = J(ξ)ξ̇,  ϖ̇(τ) = J(ξ)(ξ̈ + ½ξ̇^⋏ϖ(τ)).
+// Extrapolation: γ(τ) = Φ(τ−t_k)γ_k.
+//
+// Jacobians (left perturbations; rows [δT; δϖ; δϖ̇] at τ, columns [δT, δϖ, δϖ̇] of a knot):
+//   δT(τ) = J dξ + Ad(Exp ξ)δT_k,
+//   dϖ(τ) = ∂(Jξ̇)/∂ξ dξ + J dξ̇,
+//   dϖ̇(τ) = [∂(Jv)/∂ξ + ½Jξ̇^⋏∂(Jξ̇)/∂ξ] dξ + ½J(ξ̇^⋏J − ϖ(τ)^⋏) dξ̇ + J dξ̈,  v = ξ̈ + ½ξ̇^⋏ϖ,
+// and dγ(τ) = Λdγ_k + Ωdγ_{k+1}. All exact (checked against numeric differentiation).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/motion_model.h"
+
+namespace ctlio::gp {
+
+using PoseJacobian = Eigen::Matrix<double, 6, 18>;
+using StateJacobian = Eigen::Matrix<double, 18, 18>;
+
+class GpInterpolator {
+ public:
+  // Precomputes Λ(τ), Ω(τ). Requires t_k < t_k1 and t_k ≤ tau ≤ t_k1 (throws otherwise).
+  GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau);
+
+  // T(τ) and ∂δT(τ)/∂[δT, δϖ, δϖ̇] of each knot (6×18); any output may be null.
+  void Pose(const KnotState& k, const KnotState& k1, SE3* T, PoseJacobian* J_k,
+            PoseJacobian* J_k1) const;
+  // T(τ), ϖ(τ), ϖ̇(τ) and the 18×18 Jacobians onto each knot; any output may be null.
+  void State(const KnotState& k, const KnotState& k1, KnotState* x, StateJacobian* J_k,
+             StateJacobian* J_k1) const;
+
+  const AxisBlockMatrix<6>& Lambda() const { return lambda_; }
+  const AxisBlockMatrix<6>& Omega() const { return omega_; }
+
+ private:
+  AxisBlockMatrix<6> lambda_, omega_;
+};
+
+// Prediction past the last knot k: γ(τ) = Φ(τ−t_k)γ_k (the GP mean given x_k only).
+class GpExtrapolator {
+ public:
+  // Requires tau ≥ t_k (throws otherwise).
+  GpExtrapolator(const SingerModel<6>& model, double t_k, double tau);
+
+  void Pose(const KnotState& k, SE3* T, PoseJacobian* J_k) const;
+  void State(const KnotState& k, KnotState* x, StateJacobian* J_k) const;
+
+  const AxisBlockMatrix<6>& Transition() const { return phi_; }
+
+ private:
+  AxisBlockMatrix<6> phi_;
+};
+
+}  // namespace ctlio::gp

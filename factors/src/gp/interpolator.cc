@@ -1,0 +1,213 @@
+#include "ctlio/factors/gp/interpolator.h"
+
+#include <optional>
+#include <string>
+
+namespace ctlio::gp {
+namespace {
+
+using Diag = AxisBlockMatrix<6>::Diag;
+
+// Writes the (rows × 6) image M·[X0; X1; X2] of one knot variable's dγ(τ) into columns
+// [c, c+6) of out, M = [[J, 0, 0], [M21, J, 0], [M31, M32, J]] (interpolator.h).
+struct OutputMap {
+  Mat6 J, M21, M31, M32;
+};
+
+template <int R>
+void Apply(const OutputMap& M, const Mat6& X0, const Mat6& X1, const Mat6& X2, int c,
+           Eigen::Matrix<double, R, 18>* out) {
+  out->template block<6, 6>(0, c).noalias() = M.J * X0;
+  if constexpr (R == 18) {
+    auto b1 = out->template block<6, 6>(6, c);
+    b1.noalias() = M.M21 * X0;
+    b1.noalias() += M.J * X1;
+    auto b2 = out->template block<6, 6>(12, c);
+    b2.noalias() = M.M31 * X0;
+    b2.noalias() += M.M32 * X1;
+    b2.noalias() += M.J * X2;
+  }
+}
+
+// Same for a variable whose dγ(τ) blocks are diagonal (knot k's ϖ, ϖ̇: the columns of Λ).
+template <int R>
+void ApplyDiag(const OutputMap& M, const Diag& d0, const Diag& d1, const Diag& d2, int c,
+               Eigen::Matrix<double, R, 18>* out) {
+  out->template block<6, 6>(0, c).noalias() = M.J * d0.matrix().asDiagonal();
+  if constexpr (R == 18) {
+    out->template block<6, 6>(6, c).noalias() =
+        M.M21 * d0.matrix().asDiagonal() + M.J * d1.matrix().asDiagonal();
+    out->template block<6, 6>(12, c).noalias() = M.M31 * d0.matrix().asDiagonal() +
+                                                 M.M32 * d1.matrix().asDiagonal() +
+                                                 M.J * d2.matrix().asDiagonal();
+  }
+}
+
+// The one implementation behind GpInterpolator (omega, k1 non-null) and GpExtrapolator
+// (both null, lambda = Φ(τ−t_k)). R = 6: pose only; R = 18: full state.
+template <int R>
+void Evaluate(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>* omega, const KnotState& k,
+              const KnotState* k1, SE3* T, Vec6* velocity, Vec6* acceleration,
+              Eigen::Matrix<double, R, 18>* J_k, Eigen::Matrix<double, R, 18>* J_k1) {
+  const bool jac = J_k != nullptr || J_k1 != nullptr;
+  const bool two_knots = k1 != nullptr;
+  // γ(τ) = Λγ_k + Ωγ_{k+1}, γ_k = [0; ϖ_k; ϖ̇_k].
+  Vec6 g[3];
+  for (int r = 0; r < 3; ++r) {
+    g[r] = (lambda.block(r, 1) * k.velocity.array() + lambda.block(r, 2) * k.acceleration.array())
+               .matrix();
+  }
+  std::optional<LocalVariables> lv;
+  if (two_knots) {
+    lv.emplace(k, *k1, jac);
+    for (int r = 0; r < 3; ++r) {
+      g[r].array() += omega->block(r, 0) * lv->gamma[0].array() +
+                      omega->block(r, 1) * lv->gamma[1].array() +
+                      omega->block(r, 2) * lv->gamma[2].array();
+    }
+  }
+  const Vec6& xi = g[0];
+  const SE3 E = SE3::Exp(xi);
+  if (T != nullptr) *T = E * k.pose;
+  if (R == 6 && !jac) return;
+
+  OutputMap M;
+  M.J = se3::LeftJacobian(xi);
+  Vec6 vel, v;
+  if constexpr (R == 18) {
+    vel.noalias() = M.J * g[1];
+    const Mat6 Xd = se3::CurlyHat(g[1]);
+    v = g[2];
+    v.noalias() += 0.5 * Xd * vel;
+    if (velocity != nullptr) *velocity = vel;
+    if (acceleration != nullptr) acceleration->noalias() = M.J * v;
+    if (!jac) return;
+    M.M21 = LeftJacobianVectorDerivative(xi, g[1]);
+    const Mat6 K = M.J * Xd;  // J·ξ̇^⋏
+    M.M31 = LeftJacobianVectorDerivative(xi, v);
+    M.M31.noalias() += 0.5 * K * M.M21;
+    M.M32.noalias() = 0.5 * K * M.J;
+    M.M32.noalias() -= 0.5 * M.J * se3::CurlyHat(vel);
+  }
+
+  // Knot k+1, and through Ad(T21) knot k's pose (∂γ_{k+1}/∂δT_k = −∂γ_{k+1}/∂δT_{k+1}·Ad21).
+  Eigen::Matrix<double, R, 6> out_T1;
+  if (two_knots) {
+    const LocalVariables& l = *lv;
+    const AxisBlockMatrix<6>& O = *omega;
+    auto diag = [](const Diag& d) { return d.matrix().asDiagonal(); };
+    Mat6 X[3];
+    if constexpr (R == 6) {
+      Mat6 R0 = diag(O.block(0, 1)) * l.D1;
+      R0.noalias() += diag(O.block(0, 2)) * l.D2;
+      R0.diagonal() += O.block(0, 0).matrix();
+      X[0].noalias() = R0 * l.J_inv;
+    } else {
+      const Mat6 DJ1 = l.D1 * l.J_inv, DJ2 = l.D2 * l.J_inv;
+      for (int r = 0; r < 3; ++r) {
+        X[r].noalias() = diag(O.block(r, 0)) * l.J_inv;
+        X[r].noalias() += diag(O.block(r, 1)) * DJ1;
+        X[r].noalias() += diag(O.block(r, 2)) * DJ2;
+      }
+    }
+    Eigen::Matrix<double, R, 18> tmp;
+    Eigen::Matrix<double, R, 18>* t1 = J_k1 != nullptr ? J_k1 : &tmp;
+    Apply<R>(M, X[0], X[1], X[2], 0, t1);
+    out_T1 = t1->template leftCols<6>();
+    if (J_k1 != nullptr) {
+      for (int r = 0; r < 3; ++r) {
+        X[r].noalias() = diag(O.block(r, 1)) * l.J_inv;
+        X[r].noalias() += diag(O.block(r, 2)) * l.E;
+      }
+      Apply<R>(M, X[0], X[1], X[2], 6, J_k1);
+      for (int r = 0; r < 3; ++r) X[r].noalias() = diag(O.block(r, 2)) * l.J_inv;
+      Apply<R>(M, X[0], X[1], X[2], 12, J_k1);
+    }
+  }
+  if (J_k != nullptr) {
+    if (two_knots) {
+      J_k->template leftCols<6>().noalias() = -out_T1 * lv->Ad21;
+    } else {
+      J_k->template leftCols<6>().setZero();
+    }
+    J_k->template block<6, 6>(0, 0) += E.Adjoint();
+    ApplyDiag<R>(M, lambda.block(0, 1), lambda.block(1, 1), lambda.block(2, 1), 6, J_k);
+    ApplyDiag<R>(M, lambda.block(0, 2), lambda.block(1, 2), lambda.block(2, 2), 12, J_k);
+  }
+}
+
+[[noreturn]] void Throw(int line, const std::string& what) {
+  internal::ThrowInvalid(__FILE__, line, what);
+}
+
+}  // namespace
+
+GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau) {
+  if (!(t_k1 > t_k) || !(tau >= t_k) || !(tau <= t_k1)) {
+    Throw(__LINE__,
+          "GpInterpolator needs t_k < t_k1 and t_k <= tau <= t_k1, got t_k=" + std::to_string(t_k) +
+              " t_k1=" + std::to_string(t_k1) + " tau=" + std::to_string(tau));
+  }
+  const double d1 = tau - t_k, d2 = t_k1 - tau, dT = t_k1 - t_k;
+  const auto& alpha = model.alpha();
+  Eigen::Matrix3d L, O;
+  for (int i = 0; i < 6; ++i) {
+    if (i == 0 || alpha[i] != alpha[i - 1]) {
+      // Qc cancels in Ω and Λ, so the dimensionless shapes with Qc = 1 suffice.
+      const SingerShape sT = EvaluateSingerShape(alpha[i] * dT);
+      const Eigen::Matrix3d W = SingerSqrtInformationFromShape(sT, 1.0, dT);
+      const Eigen::Matrix3d PhiT = SingerModel<6>::ShapeTransition(sT, dT);
+      if (d1 == 0.0) {
+        O.setZero();
+      } else {
+        const SingerShape s1 = EvaluateSingerShape(alpha[i] * d1);
+        const SingerShape s2 = EvaluateSingerShape(alpha[i] * d2);
+        const Eigen::Matrix3d Q1 = SingerModel<6>::Scaled(s1, d1);
+        const Eigen::Matrix3d Phi2 = SingerModel<6>::ShapeTransition(s2, d2);
+        O = Q1 * Phi2.transpose() * W.transpose() * W;
+      }
+      const Eigen::Matrix3d Phi1 =
+          SingerModel<6>::ShapeTransition(EvaluateSingerShape(alpha[i] * d1), d1);
+      L = Phi1 - O * PhiT;
+    }
+    lambda_.SetAxis(i, L);
+    omega_.SetAxis(i, O);
+  }
+}
+
+void GpInterpolator::Pose(const KnotState& k, const KnotState& k1, SE3* T, PoseJacobian* J_k,
+                          PoseJacobian* J_k1) const {
+  Evaluate<6>(lambda_, &omega_, k, &k1, T, nullptr, nullptr, J_k, J_k1);
+}
+
+void GpInterpolator::State(const KnotState& k, const KnotState& k1, KnotState* x,
+                           StateJacobian* J_k, StateJacobian* J_k1) const {
+  KnotState tmp;
+  KnotState* out = x != nullptr ? x : &tmp;
+  Evaluate<18>(lambda_, &omega_, k, &k1, &out->pose, &out->velocity, &out->acceleration, J_k, J_k1);
+}
+
+GpExtrapolator::GpExtrapolator(const SingerModel<6>& model, double t_k, double tau) {
+  if (!(tau >= t_k)) {
+    Throw(__LINE__, "GpExtrapolator needs tau >= t_k, got t_k=" + std::to_string(t_k) +
+                        " tau=" + std::to_string(tau));
+  }
+  if (tau == t_k) {
+    for (int i = 0; i < 3; ++i) phi_.block(i, i).setOnes();
+  } else {
+    phi_ = model.TransitionBlocks(tau - t_k);
+  }
+}
+
+void GpExtrapolator::Pose(const KnotState& k, SE3* T, PoseJacobian* J_k) const {
+  Evaluate<6>(phi_, nullptr, k, nullptr, T, nullptr, nullptr, J_k, nullptr);
+}
+
+void GpExtrapolator::State(const KnotState& k, KnotState* x, StateJacobian* J_k) const {
+  KnotState tmp;
+  KnotState* out = x != nullptr ? x : &tmp;
+  Evaluate<18>(phi_, nullptr, k, nullptr, &out->pose, &out->velocity, &out->acceleration, J_k,
+               nullptr);
+}
+
+}  // namespace ctlio::gp

@@ -1,0 +1,325 @@
+// GpInterpolator / GpExtrapolator (SPEC §2): values (endpoints, prior mean) and every Jacobian
+// against ceres::GradientChecker at large, small and near-switch configurations; plus the
+// derivative of the SE(3) left Jacobian it relies on.
+#include "ctlio/factors/gp/interpolator.h"
+
+#include <ceres/sized_cost_function.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "common/gradient_check.h"
+#include "ctlio/factors/gp/se3_jacobian_derivative.h"
+#include "gp_test_util.h"
+
+namespace ctlio::gp {
+namespace {
+
+using ctlio::gp::testing::JacobiansMatchNumericScaled;
+using ctlio::testing::PoseParameters;
+using ctlio::testing::RandomPose;
+using ctlio::testing::RandomVec6;
+const PoseManifold kPoseManifold;
+
+// ---- ∂(J(ξ)w)/∂ξ against central differences (Ridders-free: smooth, step 1e-6) ----
+TEST(Se3JacobianDerivativeTest, MatchesNumericDifferentiation) {
+  std::mt19937 rng(7);
+  for (double angle : {0.0, 1e-9, 1e-4, 0.3, 1.0, 1.999, 2.0, 2.001, 2.5, 3.1, 3.14159}) {
+    for (int trial = 0; trial < 3; ++trial) {
+      Vec6 xi = RandomVec6(rng, 2.0);
+      const Vec3 axis = xi.tail<3>().normalized();
+      xi.tail<3>() = angle * axis;
+      const Vec6 w = RandomVec6(rng, 3.0);
+      const Mat6 D = LeftJacobianVectorDerivative(xi, w);
+      Mat6 Dn;
+      const double h = 1e-6;
+      for (int j = 0; j < 6; ++j) {
+        Vec6 e = Vec6::Zero();
+        e[j] = h;
+        Dn.col(j) = (se3::LeftJacobian(xi + e) * w - se3::LeftJacobian(xi - e) * w) / (2 * h);
+      }
+      EXPECT_LE((D - Dn).norm(), 1e-8 * (1.0 + Dn.norm())) << "angle " << angle << "\n"
+                                                           << D << "\n\n"
+                                                           << Dn;
+      const Mat6 Ji = se3::LeftJacobianInverse(xi);
+      const Mat6 Di = LeftJacobianInverseVectorDerivative(xi, Ji, w);
+      for (int j = 0; j < 6; ++j) {
+        Vec6 e = Vec6::Zero();
+        e[j] = h;
+        Dn.col(j) =
+            (se3::LeftJacobianInverse(xi + e) * w - se3::LeftJacobianInverse(xi - e) * w) / (2 * h);
+      }
+      EXPECT_LE((Di - Dn).norm(), 1e-7 * (1.0 + Dn.norm())) << "angle " << angle;
+    }
+  }
+}
+
+TEST(Se3JacobianDerivativeTest, CoefficientSeriesAndClosedFormsAgreeAtSwitch) {
+  const Se3JacobianCoefficients a(std::nextafter(4.0, 0.0)), b(4.0);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(a.c[i], b.c[i], 1e-14 * std::abs(b.c[i]));
+    EXPECT_NEAR(a.dc[i], b.dc[i], 1e-13 * std::abs(b.dc[i]));
+  }
+}
+
+template <int R, typename Derived>
+void StoreEuclidean(const Eigen::MatrixBase<Derived>& J, double* out) {
+  Eigen::Map<Eigen::Matrix<double, R, 6, Eigen::RowMajor>> m(out);
+  m = J;
+}
+
+// ---- Cost-function wrappers so that GradientChecker sees the interpolator ----
+// Residual [Log(T(τ)T̄⁻¹); ϖ(τ); ϖ̇(τ)] with T̄ fixed: its Jacobian is J⁻¹(r)·(our δT rows).
+class InterpolatedStateCost : public ceres::SizedCostFunction<18, 7, 6, 6, 7, 6, 6> {
+ public:
+  InterpolatedStateCost(const GpInterpolator& interp, const SE3& T_bar)
+      : interp_(interp), T_bar_inv_(T_bar.Inverse()) {}
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const KnotState k = ReadKnotState(p[0], p[1], p[2]);
+    const KnotState k1 = ReadKnotState(p[3], p[4], p[5]);
+    KnotState x;
+    StateJacobian Jk, Jk1;
+    const bool jac = jacobians != nullptr;
+    interp_.State(k, k1, &x, jac ? &Jk : nullptr, jac ? &Jk1 : nullptr);
+    Eigen::Map<Eigen::Matrix<double, 18, 1>> r(residuals);
+    const Vec6 e = (x.pose * T_bar_inv_).Log();
+    r << e, x.velocity, x.acceleration;
+    if (!jac) return true;
+    const Mat6 Ji = se3::LeftJacobianInverse(e);
+    for (int knot = 0; knot < 2; ++knot) {
+      StateJacobian J = knot == 0 ? Jk : Jk1;
+      J.topRows<6>() = Ji * J.topRows<6>();
+      double** jj = jacobians + 3 * knot;
+      if (jj[0]) LiftPoseJacobian<18>(J.leftCols<6>(), p[3 * knot], jj[0]);
+      for (int b = 1; b < 3; ++b) {
+        if (jj[b]) StoreEuclidean<18>(J.middleCols<6>(6 * b), jj[b]);
+      }
+    }
+    return true;
+  }
+
+ private:
+  const GpInterpolator& interp_;
+  SE3 T_bar_inv_;
+};
+
+class InterpolatedPoseCost : public ceres::SizedCostFunction<6, 7, 6, 6, 7, 6, 6> {
+ public:
+  InterpolatedPoseCost(const GpInterpolator& interp, const SE3& T_bar)
+      : interp_(interp), T_bar_inv_(T_bar.Inverse()) {}
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const KnotState k = ReadKnotState(p[0], p[1], p[2]);
+    const KnotState k1 = ReadKnotState(p[3], p[4], p[5]);
+    SE3 T;
+    PoseJacobian Jk, Jk1;
+    const bool jac = jacobians != nullptr;
+    interp_.Pose(k, k1, &T, jac ? &Jk : nullptr, jac ? &Jk1 : nullptr);
+    const Vec6 e = (T * T_bar_inv_).Log();
+    Eigen::Map<Vec6> r(residuals);
+    r = e;
+    if (!jac) return true;
+    const Mat6 Ji = se3::LeftJacobianInverse(e);
+    for (int knot = 0; knot < 2; ++knot) {
+      const PoseJacobian J = Ji * (knot == 0 ? Jk : Jk1);
+      double** jj = jacobians + 3 * knot;
+      if (jj[0]) LiftPoseJacobian<6>(J.leftCols<6>(), p[3 * knot], jj[0]);
+      for (int b = 1; b < 3; ++b) {
+        if (jj[b]) StoreEuclidean<6>(J.middleCols<6>(6 * b), jj[b]);
+      }
+    }
+    return true;
+  }
+
+ private:
+  const GpInterpolator& interp_;
+  SE3 T_bar_inv_;
+};
+
+class ExtrapolatedStateCost : public ceres::SizedCostFunction<18, 7, 6, 6> {
+ public:
+  ExtrapolatedStateCost(const GpExtrapolator& ex, const SE3& T_bar)
+      : ex_(ex), T_bar_inv_(T_bar.Inverse()) {}
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const KnotState k = ReadKnotState(p[0], p[1], p[2]);
+    KnotState x;
+    StateJacobian J;
+    ex_.State(k, &x, jacobians ? &J : nullptr);
+    const Vec6 e = (x.pose * T_bar_inv_).Log();
+    Eigen::Map<Eigen::Matrix<double, 18, 1>>(residuals) << e, x.velocity, x.acceleration;
+    if (!jacobians) return true;
+    J.topRows<6>() = se3::LeftJacobianInverse(e) * J.topRows<6>();
+    if (jacobians[0]) LiftPoseJacobian<18>(J.leftCols<6>(), p[0], jacobians[0]);
+    for (int b = 1; b < 3; ++b) {
+      if (jacobians[b]) StoreEuclidean<18>(J.middleCols<6>(6 * b), jacobians[b]);
+    }
+    return true;
+  }
+
+ private:
+  const GpExtrapolator& ex_;
+  SE3 T_bar_inv_;
+};
+
+SingerModel<6> LioModel() {
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  return SingerModel<6>(qc, alpha);
+}
+
+struct Case {
+  const char* name;
+  double max_angle;  // of each knot pose
+  double rel_angle;  // of T_{k+1}T_k⁻¹
+  double vel_scale, acc_scale;
+  Vec6 alpha;
+  double dt, frac;
+};
+
+std::vector<Case> Cases() {
+  Vec6 a0 = Vec6::Zero(), a_lio, a_switch, a_mixed;
+  a_lio << 0, 0, 0, 100, 100, 100;
+  // α·(τ−t_k), α·(t_k1−τ) and α·T straddling the series switch x = 1.25.
+  const double dt = 0.1;
+  a_switch << kSingerSeriesSwitch / dt, kSingerSeriesSwitch / (0.5 * dt),
+      kSingerSeriesSwitch / (0.5 * dt) * 1.0000001, kSingerSeriesSwitch / dt * 0.9999999, 3.0, 1e-9;
+  a_mixed << 0, 1e-6, 0.5, 7.0, 40.0, 1e3;
+  return {
+      {"large_rotation_wnoj", 3.1, 2.5, 3.0, 5.0, a0, 0.1, 0.37},
+      {"large_rotation_singer", 3.1, 2.8, 4.0, 10.0, a_lio, 0.1, 0.61},
+      {"small_rotation", 1e-7, 1e-7, 1e-6, 1e-6, a_lio, 0.1, 0.5},
+      {"near_series_switch", 1.0, 0.7, 1.0, 2.0, a_switch, dt, 0.5},
+      {"mixed_alpha_long_dt", 2.0, 1.5, 1.0, 1.0, a_mixed, 1.0, 0.2},
+  };
+}
+
+struct Knots {
+  std::vector<double> p0, v0, a0, p1, v1, a1;
+  KnotState k, k1;
+};
+
+Knots MakeKnots(std::mt19937& rng, const Case& c) {
+  Knots K;
+  K.k.pose = RandomPose(rng, c.max_angle, 5.0);
+  const SE3 rel = RandomPose(rng, c.rel_angle, 1.0);
+  K.k1.pose = rel * K.k.pose;
+  K.k.velocity = RandomVec6(rng, c.vel_scale);
+  K.k1.velocity = RandomVec6(rng, c.vel_scale);
+  K.k.acceleration = RandomVec6(rng, c.acc_scale);
+  K.k1.acceleration = RandomVec6(rng, c.acc_scale);
+  K.p0 = PoseParameters(K.k.pose);
+  K.p1 = PoseParameters(K.k1.pose);
+  K.v0.assign(K.k.velocity.data(), K.k.velocity.data() + 6);
+  K.a0.assign(K.k.acceleration.data(), K.k.acceleration.data() + 6);
+  K.v1.assign(K.k1.velocity.data(), K.k1.velocity.data() + 6);
+  K.a1.assign(K.k1.acceleration.data(), K.k1.acceleration.data() + 6);
+  return K;
+}
+
+TEST(GpInterpolatorTest, JacobiansMatchNumeric) {
+  std::mt19937 rng(42);
+  for (const Case& c : Cases()) {
+    Vec6 qc;
+    qc << 1, 2, 3, 4, 5, 6;
+    const SingerModel<6> model(qc, c.alpha);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Knots K = MakeKnots(rng, c);
+      const double t0 = 3.0, tau = t0 + c.frac * c.dt;
+      const GpInterpolator interp(model, t0, t0 + c.dt, tau);
+      KnotState x;
+      interp.State(K.k, K.k1, &x, nullptr, nullptr);
+      const std::vector<const ceres::Manifold*> m{&kPoseManifold, nullptr, nullptr,
+                                                  &kPoseManifold, nullptr, nullptr};
+      const std::vector<const double*> p{K.p0.data(), K.v0.data(), K.a0.data(),
+                                         K.p1.data(), K.v1.data(), K.a1.data()};
+      InterpolatedStateCost state_cost(interp, x.pose);
+      EXPECT_TRUE(JacobiansMatchNumericScaled(state_cost, m, p, 1e-8)) << c.name;
+      InterpolatedPoseCost pose_cost(interp, x.pose);
+      EXPECT_TRUE(JacobiansMatchNumericScaled(pose_cost, m, p, 1e-8)) << c.name;
+      // Pose() and State() agree.
+      SE3 T;
+      PoseJacobian Jp0, Jp1;
+      StateJacobian Js0, Js1;
+      interp.Pose(K.k, K.k1, &T, &Jp0, &Jp1);
+      interp.State(K.k, K.k1, nullptr, &Js0, &Js1);
+      EXPECT_TRUE(T.Matrix().isApprox(x.pose.Matrix(), 1e-14));
+      EXPECT_TRUE(Jp0.isApprox(Js0.topRows<6>(), 1e-12)) << c.name;
+      EXPECT_TRUE(Jp1.isApprox(Js1.topRows<6>(), 1e-12)) << c.name;
+    }
+  }
+}
+
+TEST(GpExtrapolatorTest, JacobiansMatchNumeric) {
+  std::mt19937 rng(5);
+  for (const Case& c : Cases()) {
+    const SingerModel<6> model(Vec6::Constant(2.0), c.alpha);
+    const Knots K = MakeKnots(rng, c);
+    const GpExtrapolator ex(model, 1.0, 1.0 + 1.3 * c.dt);
+    KnotState x;
+    ex.State(K.k, &x, nullptr);
+    ExtrapolatedStateCost cost(ex, x.pose);
+    EXPECT_TRUE(JacobiansMatchNumericScaled(cost, {&kPoseManifold, nullptr, nullptr},
+                                            {K.p0.data(), K.v0.data(), K.a0.data()}, 1e-8))
+        << c.name;
+    SE3 T;
+    PoseJacobian Jp;
+    StateJacobian Js;
+    ex.Pose(K.k, &T, &Jp);
+    ex.State(K.k, nullptr, &Js);
+    EXPECT_TRUE(Jp.isApprox(Js.topRows<6>(), 1e-12));
+  }
+}
+
+::testing::AssertionResult StatesNear(const KnotState& a, const KnotState& b, double tol) {
+  const double dp = (a.pose * b.pose.Inverse()).Log().norm();
+  const double dv = (a.velocity - b.velocity).norm() / (1.0 + b.velocity.norm());
+  const double da = (a.acceleration - b.acceleration).norm() / (1.0 + b.acceleration.norm());
+  if (dp <= tol && dv <= tol && da <= tol) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "pose " << dp << " vel " << dv << " acc " << da;
+}
+
+TEST(GpInterpolatorTest, TrajectoryOnThePriorMeanIsReproduced) {
+  // x_{k+1} = the prior mean from x_k; interpolating between x_k and x_{k+1} must return the
+  // prior mean at every τ (γ_{k+1} = Φ(T)γ_k ⇒ Λγ_k + Ωγ_{k+1} = Φ(τ−t_k)γ_k).
+  std::mt19937 rng(3);
+  for (const Case& c : Cases()) {
+    const SingerModel<6> model(Vec6::Constant(1.0), c.alpha);
+    KnotState k;
+    k.pose = RandomPose(rng, 2.0, 3.0);
+    k.velocity = RandomVec6(rng, 1.0);  // small enough that |ξ21| stays below π
+    k.acceleration = RandomVec6(rng, 1.0);
+    const double t0 = 10.0, t1 = t0 + c.dt;
+    KnotState k1;
+    GpExtrapolator(model, t0, t1).State(k, &k1, nullptr);
+    for (double f : {0.0, 0.1, 0.5, 0.77, 1.0}) {
+      const double tau = t0 + f * c.dt;
+      KnotState mean, interp;
+      GpExtrapolator(model, t0, tau).State(k, &mean, nullptr);
+      GpInterpolator(model, t0, t1, tau).State(k, k1, &interp, nullptr, nullptr);
+      EXPECT_TRUE(StatesNear(interp, mean, 1e-9)) << c.name << " f " << f;
+    }
+  }
+}
+
+TEST(GpInterpolatorTest, EndpointsReturnTheKnots) {
+  std::mt19937 rng(11);
+  const SingerModel<6> model = LioModel();
+  const Knots K = MakeKnots(rng, Cases()[1]);
+  KnotState x;
+  GpInterpolator(model, 0.0, 0.1, 0.0).State(K.k, K.k1, &x, nullptr, nullptr);
+  EXPECT_TRUE(StatesNear(x, K.k, 1e-9));
+  GpInterpolator(model, 0.0, 0.1, 0.1).State(K.k, K.k1, &x, nullptr, nullptr);
+  EXPECT_TRUE(StatesNear(x, K.k1, 1e-9));
+}
+
+TEST(GpInterpolatorTest, RejectsBadTimes) {
+  const SingerModel<6> model = LioModel();
+  EXPECT_THROW(GpInterpolator(model, 1.0, 1.0, 1.0), std::runtime_error);
+  EXPECT_THROW(GpInterpolator(model, 1.0, 2.0, 2.5), std::runtime_error);
+  EXPECT_THROW(GpInterpolator(model, 1.0, 2.0, 0.5), std::runtime_error);
+  EXPECT_THROW(GpExtrapolator(model, 1.0, 0.5), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace ctlio::gp
