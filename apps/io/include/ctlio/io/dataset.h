@@ -1,0 +1,84 @@
+// The one interface the odometry consumes (issue 8): a sequence of lidar scans with ABSOLUTE
+// int64-ns per-point times (SPEC §1), the IMU samples between consecutive scans, the lidar→IMU
+// extrinsic and optional ground truth. Implemented by every dataset reader (Newer College 2020,
+// ctlio's simulator folder, KITTI) and by the in-memory simulator source (apps/sim).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ctlio/io/point_cloud_io.h"
+#include "ctlio/manifolds/se3.h"
+#include "ctlio/manifolds/types.h"
+
+namespace ctlio::io {
+
+// One IMU sample in the IMU frame: angular rate [rad/s] and specific force [m/s²].
+struct ImuSample {
+  int64_t t_ns = 0;
+  Vec3 gyro = Vec3::Zero();
+  Vec3 accel = Vec3::Zero();
+};
+
+// A timestamped pose. In ground truth it is T_world_lidar: the lidar frame's pose in a fixed world
+// frame (maps lidar coordinates into world coordinates, SPEC §1).
+struct StampedPose {
+  int64_t t_ns = 0;
+  SE3 pose;
+};
+
+// One lidar scan plus the IMU samples with times in (end of the previous scan, end of this scan];
+// the first scan also gets every earlier sample. `cloud.times_ns` are absolute and always present
+// (sources without per-point times are rejected or documented to fill them).
+struct ScanFrame {
+  size_t index = 0;
+  int64_t start_ns = 0;  // scan stamp (= cloud.stamp_ns)
+  int64_t end_ns = 0;    // the latest per-point time
+  PointCloud cloud;      // lidar frame
+  std::vector<ImuSample> imu;
+};
+
+class DataSource {
+ public:
+  virtual ~DataSource() = default;
+  // Short human-readable description ("newer_college:/path", "sim:fast/03", ...).
+  virtual std::string Name() const = 0;
+  // Number of scans, if known in advance (0 = unknown).
+  virtual size_t NumScans() const = 0;
+  // Fills the next scan; false when the sequence is exhausted. Throws std::runtime_error (naming
+  // file and line) on bad input.
+  virtual bool Next(ScanFrame* frame) = 0;
+  // T_imu_lidar: maps lidar coordinates into the IMU frame.
+  virtual SE3 ImuFromLidar() const = 0;
+  // Ground truth T_world_lidar, time-sorted, if the source has it.
+  virtual std::optional<std::vector<StampedPose>> GroundTruth() const { return std::nullopt; }
+  // Gravity magnitude the IMU data assume, if the source knows it (simulator: exact value).
+  virtual std::optional<double> Gravity() const { return std::nullopt; }
+};
+
+// Groups a time-sorted IMU stream and scans: appends the samples with start < t ≤ end to *out,
+// advancing *cursor. Used by every reader so that "IMU between scans" means the same everywhere.
+void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cursor,
+                  std::vector<ImuSample>* out);
+
+// Checks an IMU stream read from `path` (lines[i] = line number of imu[i]) and applies the
+// documented recoveries, logged with glog:
+//   * a sample with the same time as the previous one (duplicate) is dropped, with a warning;
+//   * a time going backwards is an error "<path>:<line>: IMU time goes backwards ...";
+//   * a gap larger than `max_gap_ns` is an error "<path>:<line>: gap of ... in the IMU" (0 = off).
+void CheckImuStream(const std::string& path, const std::vector<int>& lines, int64_t max_gap_ns,
+                    std::vector<ImuSample>* imu);
+
+// Decimal seconds (as in TUM files) to int64 ns without going through double, so that
+// 1583836591.182590000 stays exact. Returns false if `s` is not a decimal number.
+bool ParseSecondsNs(const std::string& s, int64_t* ns);
+std::string FormatSecondsNs(int64_t ns);  // "<sec>.<9 digits>"
+
+// Opens any supported dataset folder by looking at its contents: Newer College 2020
+// (raw_format/), ctlio simulator (ctlio_sim.yaml) or KITTI (velodyne/). Throws if none matches.
+std::unique_ptr<DataSource> OpenDataset(const std::string& folder);
+
+}  // namespace ctlio::io

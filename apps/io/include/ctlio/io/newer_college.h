@@ -1,0 +1,63 @@
+// Newer College Dataset 2020 layout (SPEC §6):
+//   <seq>/raw_format/ouster_zip_files/ouster_scan/<name>_<sec>_<nsec>.pcd
+//       Ouster OS1 fields x y z intensity t reflectivity ring noise range, t = uint32 ns since the
+//       stamp in the file name;
+//   <seq>/raw_format/ouster_imu/data.csv      header, then counter, sec, nsec, wx wy wz, ax ay az;
+//   <seq>/ground_truth/registered_poses.csv   header, then sec, nsec, x y z, qx qy qz qw.
+// Ground truth is read as T_world_lidar. Lidar→IMU: the published extrinsic, overridable.
+//
+// Documented recoveries (logged): duplicate IMU times are dropped; scans are ordered by the stamp
+// in their file names (a directory listing is unordered). Errors (file and line): missing
+// folders/files, malformed CSV lines, a PCD without the 't' field, two scans with one stamp, IMU
+// time going backwards, IMU gaps longer than `max_imu_gap_ns`, ground truth out of order.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ctlio/io/dataset.h"
+
+namespace ctlio::io {
+
+// T_imu_lidar of the Newer College 2020 Ouster: rotation diag(−1, −1, 1),
+// translation (−0.006253, 0.011775, 0.028535) m (SPEC §6).
+SE3 NewerCollegeImuFromLidar();
+
+struct NewerCollegeOptions {
+  SE3 imu_from_lidar = NewerCollegeImuFromLidar();
+  int64_t max_imu_gap_ns = 100'000'000;  // 0.1 s (the Ouster IMU runs at 100 Hz)
+  bool require_ground_truth = false;     // otherwise a missing registered_poses.csv is logged
+};
+
+class NewerCollegeReader : public DataSource {
+ public:
+  explicit NewerCollegeReader(const std::string& sequence_folder,
+                              const NewerCollegeOptions& options = {});
+  std::string Name() const override { return "newer_college:" + folder_; }
+  size_t NumScans() const override { return scans_.size(); }
+  bool Next(ScanFrame* frame) override;
+  SE3 ImuFromLidar() const override { return options_.imu_from_lidar; }
+  std::optional<std::vector<StampedPose>> GroundTruth() const override;
+  const std::vector<ImuSample>& imu() const { return imu_; }
+
+ private:
+  std::string folder_;
+  NewerCollegeOptions options_;
+  std::vector<std::pair<int64_t, std::string>> scans_;  // (stamp, path), sorted
+  std::vector<ImuSample> imu_;
+  std::vector<StampedPose> ground_truth_;
+  size_t next_ = 0, imu_cursor_ = 0;
+};
+
+// Writes any data source in the Newer College layout (scan files named cloud_<sec>_<nsec>.pcd,
+// IMU counter from 0, ground truth if the source has it). `progress(done, total)` is called after
+// each scan. Returns the number of scans written.
+size_t WriteNewerCollege(DataSource& source, const std::string& sequence_folder,
+                         const std::function<void(size_t, size_t)>& progress = {});
+
+// "<prefix>_<sec>_<nsec>.pcd" → stamp in ns; false if the name does not match.
+bool ParseNewerCollegeScanName(const std::string& file_name, int64_t* stamp_ns);
+
+}  // namespace ctlio::io

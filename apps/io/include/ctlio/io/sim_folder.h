@@ -1,0 +1,55 @@
+// ctlio's own simulator folder layout (documented in apps/io/FORMAT.md):
+//   ctlio_sim.yaml        format: ctlio_sim, version: 1, gravity, imu_from_lidar, free `config`
+//   imu.csv               header "t_ns,wx,wy,wz,ax,ay,az"
+//   scans.csv             header "index,start_ns,end_ns,points,file"
+//   scans/<index>.bin     per point: float32 x y z (lidar frame), uint32 ns since start_ns
+//   ground_truth.csv      header "t_ns,x,y,z,qx,qy,qz,qw" (T_world_lidar), optional
+//   ground_truth_tum.txt  the same poses in TUM format, for ctlio_evaluate
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "ctlio/io/dataset.h"
+
+namespace ctlio::io {
+
+class SimFolderReader : public DataSource {
+ public:
+  // `max_imu_gap_ns`: IMU gaps longer than this are errors (0 = no check).
+  explicit SimFolderReader(const std::string& folder, int64_t max_imu_gap_ns = 50'000'000);
+  std::string Name() const override { return "ctlio_sim:" + folder_; }
+  size_t NumScans() const override { return scans_.size(); }
+  bool Next(ScanFrame* frame) override;
+  SE3 ImuFromLidar() const override { return imu_from_lidar_; }
+  std::optional<std::vector<StampedPose>> GroundTruth() const override;
+  std::optional<double> Gravity() const override { return gravity_; }
+
+ private:
+  struct ScanEntry {
+    int line;
+    int64_t start_ns, end_ns;
+    size_t points;
+    std::string file;
+  };
+  std::string folder_;
+  SE3 imu_from_lidar_;
+  double gravity_ = 9.81;
+  std::vector<ScanEntry> scans_;
+  std::vector<ImuSample> imu_;
+  std::vector<StampedPose> ground_truth_;
+  size_t next_ = 0, imu_cursor_ = 0;
+};
+
+// Writes any data source in the layout above. `config_yaml` (a YAML mapping, may be empty) is
+// stored under the key `config` of ctlio_sim.yaml to record how the data were made.
+size_t WriteSimFolder(DataSource& source, const std::string& folder,
+                      const std::string& config_yaml = "",
+                      const std::function<void(size_t, size_t)>& progress = {});
+
+// Reads/writes one scan file of the layout (stamp = start_ns).
+PointCloud ReadSimScan(const std::string& path, int64_t start_ns);
+void WriteSimScan(const std::string& path, const PointCloud& cloud);
+
+}  // namespace ctlio::io

@@ -1,0 +1,28 @@
+// Line-oriented numeric tables (CSV or whitespace separated) with errors naming file and line.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ctlio::io {
+
+struct TableRow {
+  int line = 0;                     // 1-based line number in the file
+  std::vector<std::string> fields;  // split on ',' and/or whitespace
+};
+
+// Reads every non-empty line that does not start with '#'. If `skip_header` is true and the first
+// such line contains a field that is not a number, it is skipped. Throws "<path>: file not found".
+std::vector<TableRow> ReadTable(const std::string& path, bool skip_header);
+
+// Strict conversions: the whole field must parse; otherwise "<path>:<line>: field k ('...') is not
+// a number". ToInt64 accepts only integers.
+double ToDouble(const std::string& path, const TableRow& row, size_t k);
+int64_t ToInt64(const std::string& path, const TableRow& row, size_t k);
+// Throws "<path>:<line>: expected N fields, found M" unless the row has exactly (or, with
+// `at_least`, at least) n fields.
+void ExpectFields(const std::string& path, const TableRow& row, size_t n, bool at_least = false);
+[[noreturn]] void FailAt(const std::string& path, int line, const std::string& what);
+
+}  // namespace ctlio::io

@@ -1,0 +1,139 @@
+#include "ctlio/io/kitti.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include "ctlio/io/text_table.h"
+#include "ctlio/io/trajectory_io.h"
+
+namespace ctlio::io {
+namespace fs = std::filesystem;
+namespace {
+
+// "<dir>/<stem>.txt" and then every "<dir>/<stem>_*.txt", sorted.
+std::vector<std::string> FindTxts(const fs::path& dir, const std::string& stem) {
+  std::vector<std::string> others;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind(stem + "_", 0) == 0 && e.path().extension() == ".txt") {
+      others.push_back(e.path().string());
+    }
+  }
+  std::sort(others.begin(), others.end());
+  std::vector<std::string> found;
+  if (fs::is_regular_file(dir / (stem + ".txt"))) found.push_back((dir / (stem + ".txt")).string());
+  found.insert(found.end(), others.begin(), others.end());
+  return found;
+}
+
+std::string FindTxt(const fs::path& dir, const std::string& stem) {
+  const auto found = FindTxts(dir, stem);
+  return found.empty() ? "" : found.front();
+}
+
+}  // namespace
+
+KittiReader::KittiReader(const std::string& folder) : folder_(folder) {
+  const fs::path dir(folder);
+  std::error_code ec;
+  if (!fs::is_directory(dir / "velodyne", ec)) {
+    throw std::runtime_error((dir / "velodyne").string() + ": folder not found");
+  }
+  for (const auto& e : fs::directory_iterator(dir / "velodyne")) {
+    if (e.path().extension() == ".bin") scans_.push_back(e.path().string());
+  }
+  std::sort(scans_.begin(), scans_.end());  // zero-padded indices: name order = time order
+  if (scans_.empty()) throw std::runtime_error((dir / "velodyne").string() + ": no .bin scans");
+  const bool xyz =
+      scans_.front().size() > 8 && scans_.front().substr(scans_.front().size() - 8) == "_xyz.bin";
+  floats_per_point_ = xyz ? 3 : 4;
+
+  const std::string times_path = FindTxt(dir, "times");
+  if (times_path.empty()) throw std::runtime_error(folder + ": no times.txt");
+  for (const auto& row : ReadTable(times_path, false)) {
+    ExpectFields(times_path, row, 1);
+    int64_t t = 0;
+    if (!ParseSecondsNs(row.fields[0], &t)) FailAt(times_path, row.line, "not a time");
+    if (!times_.empty() && t <= times_.back()) {
+      FailAt(times_path, row.line, "scan time not increasing (scans out of order)");
+    }
+    times_.push_back(t);
+  }
+  if (times_.size() < scans_.size()) {
+    throw std::runtime_error(times_path + ": " + std::to_string(times_.size()) + " times for " +
+                             std::to_string(scans_.size()) + " scans");
+  }
+  for (const auto& s : scans_) {
+    const fs::path p = dir / "velodyne_times" / fs::path(s).filename();
+    point_times_.push_back(fs::is_regular_file(p, ec) ? p.string() : "");
+  }
+
+  const std::string poses_path = FindTxt(dir, "poses");
+  if (!poses_path.empty()) {
+    std::vector<StampedPose> cam = ReadKittiPoses(poses_path);
+    SE3 Tr;  // velodyne → cam0, from the first calib*.txt with a "Tr:" line
+    bool have_tr = false;
+    for (const std::string& calib_path : FindTxts(dir, "calib")) {
+      if (have_tr) break;
+      for (const auto& row : ReadTable(calib_path, false)) {
+        if (row.fields.empty() || row.fields[0] != "Tr:") continue;
+        ExpectFields(calib_path, row, 13);
+        Mat3 C;
+        Vec3 r;
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) C(a, b) = ToDouble(calib_path, row, 1 + 4 * a + b);
+          r[a] = ToDouble(calib_path, row, 1 + 4 * a + 3);
+        }
+        Tr = SE3(Eigen::Quaterniond(C).normalized().toRotationMatrix(), r);
+        have_tr = true;
+      }
+    }
+    if (!have_tr) {
+      LOG(WARNING) << folder << ": no calib.txt, ground truth left in the cam0 frame";
+    }
+    for (size_t i = 0; i < cam.size() && i < times_.size(); ++i) {
+      ground_truth_.push_back({times_[i], Tr.Inverse() * cam[i].pose * Tr});
+    }
+  }
+}
+
+bool KittiReader::Next(ScanFrame* frame) {
+  if (next_ >= scans_.size()) return false;
+  const int64_t stamp = times_[next_];
+  frame->index = next_;
+  if (!point_times_[next_].empty()) {
+    frame->cloud = ReadKittiBin(scans_[next_], floats_per_point_, point_times_[next_], stamp);
+  } else {
+    frame->cloud = ReadKittiBin(scans_[next_], floats_per_point_, "", stamp);
+    static bool logged = false;
+    if (!logged) {
+      LOG(INFO) << folder_ << ": no per-point times, filled from the azimuth (see kitti.h)";
+      logged = true;
+    }
+    auto& c = frame->cloud;
+    c.times_ns.resize(c.size());
+    for (size_t i = 0; i < c.size(); ++i) {
+      const double az = std::atan2(c.points[i].y(), c.points[i].x());
+      c.times_ns[i] = stamp - std::llround(az / (2.0 * M_PI) * 1e8);
+    }
+    c.stamp_ns = *std::min_element(c.times_ns.begin(), c.times_ns.end());
+  }
+  frame->start_ns = frame->cloud.stamp_ns;
+  frame->end_ns = frame->cloud.has_times() ? *std::max_element(frame->cloud.times_ns.begin(),
+                                                               frame->cloud.times_ns.end())
+                                           : stamp;
+  frame->imu.clear();
+  ++next_;
+  return true;
+}
+
+std::optional<std::vector<StampedPose>> KittiReader::GroundTruth() const {
+  if (ground_truth_.empty()) return std::nullopt;
+  return ground_truth_;
+}
+
+}  // namespace ctlio::io

@@ -1,0 +1,195 @@
+#include "ctlio/io/newer_college.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+
+#include "ctlio/io/text_table.h"
+
+namespace ctlio::io {
+namespace fs = std::filesystem;
+
+namespace {
+fs::path ScanDir(const fs::path& seq) {
+  return seq / "raw_format" / "ouster_zip_files" / "ouster_scan";
+}
+fs::path ImuFile(const fs::path& seq) { return seq / "raw_format" / "ouster_imu" / "data.csv"; }
+fs::path GtFile(const fs::path& seq) { return seq / "ground_truth" / "registered_poses.csv"; }
+
+void RequireDir(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_directory(p, ec)) throw std::runtime_error(p.string() + ": folder not found");
+}
+
+SE3 PoseFromRow(const std::string& path, const TableRow& row, size_t first) {
+  const Vec3 r(ToDouble(path, row, first), ToDouble(path, row, first + 1),
+               ToDouble(path, row, first + 2));
+  const Eigen::Quaterniond q(ToDouble(path, row, first + 6), ToDouble(path, row, first + 3),
+                             ToDouble(path, row, first + 4), ToDouble(path, row, first + 5));
+  if (std::abs(q.norm() - 1.0) > 1e-3) {
+    FailAt(path, row.line, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
+  }
+  return SE3(q, r);
+}
+
+int64_t StampFromSecNsec(const std::string& path, const TableRow& row, size_t k) {
+  const int64_t sec = ToInt64(path, row, k), nsec = ToInt64(path, row, k + 1);
+  if (sec < 0 || nsec < 0 || nsec >= 1000000000) {
+    FailAt(path, row.line, "sec/nsec out of range");
+  }
+  return sec * 1000000000 + nsec;
+}
+}  // namespace
+
+SE3 NewerCollegeImuFromLidar() {
+  return SE3(Vec3(-1, -1, 1).asDiagonal().toDenseMatrix(), Vec3(-0.006253, 0.011775, 0.028535));
+}
+
+bool ParseNewerCollegeScanName(const std::string& name, int64_t* stamp_ns) {
+  if (name.size() < 5 || name.substr(name.size() - 4) != ".pcd") return false;
+  const std::string base = name.substr(0, name.size() - 4);
+  const size_t b = base.rfind('_');
+  if (b == std::string::npos || b == 0) return false;
+  const size_t a = base.rfind('_', b - 1);
+  if (a == std::string::npos) return false;
+  const std::string sec = base.substr(a + 1, b - a - 1), nsec = base.substr(b + 1);
+  if (sec.empty() || nsec.empty() || nsec.size() > 9) return false;
+  for (char c : sec + nsec) {
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  }
+  *stamp_ns = std::stoll(sec) * 1000000000 + std::stoll(nsec);
+  return true;
+}
+
+NewerCollegeReader::NewerCollegeReader(const std::string& folder,
+                                       const NewerCollegeOptions& options)
+    : folder_(folder), options_(options) {
+  const fs::path seq(folder);
+  RequireDir(seq);
+  RequireDir(ScanDir(seq));
+  for (const auto& e : fs::directory_iterator(ScanDir(seq))) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".pcd") continue;
+    int64_t stamp = 0;
+    if (!ParseNewerCollegeScanName(name, &stamp)) {
+      throw std::runtime_error(e.path().string() +
+                               ": scan file name is not <name>_<sec>_<nsec>.pcd");
+    }
+    scans_.emplace_back(stamp, e.path().string());
+  }
+  if (scans_.empty()) throw std::runtime_error(ScanDir(seq).string() + ": no .pcd scans");
+  // Recovery: order by stamp (directory listings are unordered); equal stamps are an error.
+  std::sort(scans_.begin(), scans_.end());
+  for (size_t i = 1; i < scans_.size(); ++i) {
+    if (scans_[i].first == scans_[i - 1].first) {
+      throw std::runtime_error(scans_[i].second + ": same stamp as " + scans_[i - 1].second);
+    }
+  }
+
+  const std::string imu_path = ImuFile(seq).string();
+  const auto rows = ReadTable(imu_path, /*skip_header=*/true);
+  std::vector<int> lines;
+  imu_.reserve(rows.size());
+  for (const auto& row : rows) {
+    ExpectFields(imu_path, row, 9);
+    ImuSample s;
+    s.t_ns = StampFromSecNsec(imu_path, row, 1);
+    s.gyro =
+        Vec3(ToDouble(imu_path, row, 3), ToDouble(imu_path, row, 4), ToDouble(imu_path, row, 5));
+    s.accel =
+        Vec3(ToDouble(imu_path, row, 6), ToDouble(imu_path, row, 7), ToDouble(imu_path, row, 8));
+    imu_.push_back(s);
+    lines.push_back(row.line);
+  }
+  if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
+  CheckImuStream(imu_path, lines, options_.max_imu_gap_ns, &imu_);
+
+  const std::string gt_path = GtFile(seq).string();
+  std::error_code ec;
+  if (!fs::is_regular_file(gt_path, ec)) {
+    if (options_.require_ground_truth) throw std::runtime_error(gt_path + ": file not found");
+    LOG(INFO) << gt_path << ": absent, running without ground truth";
+    return;
+  }
+  for (const auto& row : ReadTable(gt_path, /*skip_header=*/true)) {
+    ExpectFields(gt_path, row, 9);
+    const int64_t t = StampFromSecNsec(gt_path, row, 0);
+    if (!ground_truth_.empty() && t <= ground_truth_.back().t_ns) {
+      FailAt(gt_path, row.line, "ground-truth time not increasing");
+    }
+    ground_truth_.push_back({t, PoseFromRow(gt_path, row, 2)});
+  }
+}
+
+bool NewerCollegeReader::Next(ScanFrame* frame) {
+  if (next_ >= scans_.size()) return false;
+  const auto& [stamp, path] = scans_[next_];
+  ReadOptions ro;
+  ro.stamp_ns = stamp;
+  ro.require_time = true;
+  frame->index = next_;
+  frame->cloud = ReadPcd(path, ro);
+  frame->start_ns = stamp;
+  frame->end_ns = stamp;
+  for (int64_t t : frame->cloud.times_ns) frame->end_ns = std::max(frame->end_ns, t);
+  if (next_ + 1 < scans_.size() && frame->end_ns >= scans_[next_ + 1].first + 100'000'000) {
+    throw std::runtime_error(path + ": point times reach past the next scan's stamp by > 0.1 s");
+  }
+  frame->imu.clear();
+  TakeImuUntil(imu_, frame->end_ns, &imu_cursor_, &frame->imu);
+  ++next_;
+  return true;
+}
+
+std::optional<std::vector<StampedPose>> NewerCollegeReader::GroundTruth() const {
+  if (ground_truth_.empty()) return std::nullopt;
+  return ground_truth_;
+}
+
+size_t WriteNewerCollege(DataSource& source, const std::string& folder,
+                         const std::function<void(size_t, size_t)>& progress) {
+  const fs::path seq(folder);
+  fs::create_directories(ScanDir(seq));
+  fs::create_directories(ImuFile(seq).parent_path());
+  std::ofstream imu(ImuFile(seq));
+  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": cannot open for writing");
+  imu << "counter,sec,nsec,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
+  size_t counter = 0, n = 0;
+  ScanFrame frame;
+  while (source.Next(&frame)) {
+    for (const ImuSample& s : frame.imu) {
+      imu << counter++ << ',' << s.t_ns / 1000000000 << ',' << s.t_ns % 1000000000;
+      for (int k = 0; k < 3; ++k) imu << ',' << s.gyro[k];
+      for (int k = 0; k < 3; ++k) imu << ',' << s.accel[k];
+      imu << '\n';
+    }
+    char name[64];
+    std::snprintf(name, sizeof(name), "cloud_%lld_%09lld.pcd",
+                  static_cast<long long>(frame.start_ns / 1000000000),
+                  static_cast<long long>(frame.start_ns % 1000000000));
+    WritePcd((ScanDir(seq) / name).string(), frame.cloud);
+    ++n;
+    if (progress) progress(n, source.NumScans());
+  }
+  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": write failed");
+  if (const auto gt = source.GroundTruth()) {
+    fs::create_directories(GtFile(seq).parent_path());
+    std::ofstream out(GtFile(seq));
+    if (!out) throw std::runtime_error(GtFile(seq).string() + ": cannot open for writing");
+    out << "#sec,nsec,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
+    for (const auto& p : *gt) {
+      const Eigen::Quaterniond q = p.pose.quaternion();
+      const Vec3& r = p.pose.translation();
+      out << p.t_ns / 1000000000 << ',' << p.t_ns % 1000000000 << ',' << r.x() << ',' << r.y()
+          << ',' << r.z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << '\n';
+    }
+  }
+  return n;
+}
+
+}  // namespace ctlio::io

@@ -1,0 +1,219 @@
+#include "ctlio/io/sim_folder.h"
+
+#include <glog/logging.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <stdexcept>
+
+#include "ctlio/io/text_table.h"
+#include "ctlio/io/trajectory_io.h"
+
+namespace ctlio::io {
+namespace fs = std::filesystem;
+
+PointCloud ReadSimScan(const std::string& path, int64_t start_ns) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path + ": file not found");
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() % 16 != 0) {
+    throw std::runtime_error(path + ": size " + std::to_string(bytes.size()) +
+                             " B is not a multiple of 16 B per point");
+  }
+  PointCloud c;
+  c.stamp_ns = start_ns;
+  const size_t n = bytes.size() / 16;
+  c.points.reserve(n);
+  c.times_ns.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    float v[3];
+    uint32_t dt;
+    std::memcpy(v, bytes.data() + 16 * i, 12);
+    std::memcpy(&dt, bytes.data() + 16 * i + 12, 4);
+    c.points.emplace_back(v[0], v[1], v[2]);
+    c.times_ns.push_back(start_ns + int64_t(dt));
+  }
+  return c;
+}
+
+void WriteSimScan(const std::string& path, const PointCloud& cloud) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  std::vector<char> buf(16 * cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const float v[3] = {float(cloud.points[i].x()), float(cloud.points[i].y()),
+                        float(cloud.points[i].z())};
+    const int64_t dt = cloud.has_times() ? cloud.times_ns[i] - cloud.stamp_ns : 0;
+    if (dt < 0 || dt > int64_t(std::numeric_limits<uint32_t>::max())) {
+      throw std::runtime_error(path + ": point " + std::to_string(i) + " time outside the scan");
+    }
+    const uint32_t u = uint32_t(dt);
+    std::memcpy(buf.data() + 16 * i, v, 12);
+    std::memcpy(buf.data() + 16 * i + 12, &u, 4);
+  }
+  out.write(buf.data(), std::streamsize(buf.size()));
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_ns)
+    : folder_(folder) {
+  const fs::path dir(folder);
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw std::runtime_error(folder + ": folder not found");
+  const std::string meta_path = (dir / "ctlio_sim.yaml").string();
+  if (!fs::is_regular_file(meta_path, ec)) throw std::runtime_error(meta_path + ": file not found");
+  try {
+    const YAML::Node meta = YAML::LoadFile(meta_path);
+    if (!meta["format"] || meta["format"].as<std::string>() != "ctlio_sim") {
+      throw std::runtime_error("key 'format' is not 'ctlio_sim'");
+    }
+    gravity_ = meta["gravity"].as<double>();
+    const auto t = meta["imu_from_lidar"]["translation"].as<std::vector<double>>();
+    const auto q = meta["imu_from_lidar"]["quaternion_xyzw"].as<std::vector<double>>();
+    if (t.size() != 3 || q.size() != 4) throw std::runtime_error("imu_from_lidar: wrong sizes");
+    imu_from_lidar_ = SE3(Eigen::Quaterniond(q[3], q[0], q[1], q[2]), Vec3(t[0], t[1], t[2]));
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(meta_path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(meta_path + ": " + e.what());
+  }
+
+  const std::string scans_path = (dir / "scans.csv").string();
+  for (const auto& row : ReadTable(scans_path, true)) {
+    ExpectFields(scans_path, row, 5);
+    ScanEntry e{row.line, ToInt64(scans_path, row, 1), ToInt64(scans_path, row, 2),
+                size_t(ToInt64(scans_path, row, 3)), (dir / row.fields[4]).string()};
+    if (e.end_ns < e.start_ns) FailAt(scans_path, row.line, "end_ns before start_ns");
+    if (!scans_.empty() && e.start_ns <= scans_.back().start_ns) {
+      FailAt(scans_path, row.line,
+             "scan out of order (start " + std::to_string(e.start_ns) + " ns not after " +
+                 std::to_string(scans_.back().start_ns) + " ns on line " +
+                 std::to_string(scans_.back().line) + ")");
+    }
+    scans_.push_back(e);
+  }
+  if (scans_.empty()) throw std::runtime_error(scans_path + ": no scans");
+
+  const std::string imu_path = (dir / "imu.csv").string();
+  std::vector<int> lines;
+  for (const auto& row : ReadTable(imu_path, true)) {
+    ExpectFields(imu_path, row, 7);
+    ImuSample s;
+    s.t_ns = ToInt64(imu_path, row, 0);
+    s.gyro =
+        Vec3(ToDouble(imu_path, row, 1), ToDouble(imu_path, row, 2), ToDouble(imu_path, row, 3));
+    s.accel =
+        Vec3(ToDouble(imu_path, row, 4), ToDouble(imu_path, row, 5), ToDouble(imu_path, row, 6));
+    imu_.push_back(s);
+    lines.push_back(row.line);
+  }
+  if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
+  CheckImuStream(imu_path, lines, max_imu_gap_ns, &imu_);
+
+  const std::string gt_path = (dir / "ground_truth.csv").string();
+  if (fs::is_regular_file(gt_path, ec)) {
+    for (const auto& row : ReadTable(gt_path, true)) {
+      ExpectFields(gt_path, row, 8);
+      const int64_t t = ToInt64(gt_path, row, 0);
+      if (!ground_truth_.empty() && t <= ground_truth_.back().t_ns) {
+        FailAt(gt_path, row.line, "ground-truth time not increasing");
+      }
+      const Eigen::Quaterniond q(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
+                                 ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6));
+      if (std::abs(q.norm() - 1.0) > 1e-3) FailAt(gt_path, row.line, "quaternion norm is not 1");
+      ground_truth_.push_back({t, SE3(q, Vec3(ToDouble(gt_path, row, 1), ToDouble(gt_path, row, 2),
+                                              ToDouble(gt_path, row, 3)))});
+    }
+  }
+}
+
+bool SimFolderReader::Next(ScanFrame* frame) {
+  if (next_ >= scans_.size()) return false;
+  const ScanEntry& e = scans_[next_];
+  frame->index = next_;
+  frame->cloud = ReadSimScan(e.file, e.start_ns);
+  if (frame->cloud.size() != e.points) {
+    FailAt(folder_ + "/scans.csv", e.line,
+           "lists " + std::to_string(e.points) + " points, " + e.file + " has " +
+               std::to_string(frame->cloud.size()));
+  }
+  frame->start_ns = e.start_ns;
+  frame->end_ns = e.end_ns;
+  frame->imu.clear();
+  TakeImuUntil(imu_, e.end_ns, &imu_cursor_, &frame->imu);
+  ++next_;
+  return true;
+}
+
+std::optional<std::vector<StampedPose>> SimFolderReader::GroundTruth() const {
+  if (ground_truth_.empty()) return std::nullopt;
+  return ground_truth_;
+}
+
+size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::string& config_yaml,
+                      const std::function<void(size_t, size_t)>& progress) {
+  const fs::path dir(folder);
+  fs::create_directories(dir / "scans");
+  {
+    YAML::Emitter y;
+    y << YAML::BeginMap << YAML::Key << "format" << YAML::Value << "ctlio_sim";
+    y << YAML::Key << "version" << YAML::Value << 1;
+    y << YAML::Key << "source" << YAML::Value << source.Name();
+    y << YAML::Key << "gravity" << YAML::Value << source.Gravity().value_or(9.81);
+    const SE3 T = source.ImuFromLidar();
+    const Eigen::Quaterniond q = T.quaternion();
+    y << YAML::Key << "imu_from_lidar" << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "translation" << YAML::Value << YAML::Flow
+      << std::vector<double>{T.translation().x(), T.translation().y(), T.translation().z()};
+    y << YAML::Key << "quaternion_xyzw" << YAML::Value << YAML::Flow
+      << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
+    y << YAML::EndMap;
+    if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
+    y << YAML::EndMap;
+    std::ofstream out(dir / "ctlio_sim.yaml");
+    out << "# ctlio simulator dataset, layout in apps/io/FORMAT.md\n" << y.c_str() << "\n";
+    if (!out) throw std::runtime_error((dir / "ctlio_sim.yaml").string() + ": write failed");
+  }
+  std::ofstream imu(dir / "imu.csv"), scans(dir / "scans.csv");
+  if (!imu || !scans) throw std::runtime_error(folder + ": cannot write imu.csv/scans.csv");
+  imu << "t_ns,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
+  scans << "index,start_ns,end_ns,points,file\n";
+  ScanFrame frame;
+  size_t n = 0;
+  while (source.Next(&frame)) {
+    for (const ImuSample& s : frame.imu) {
+      imu << s.t_ns;
+      for (int k = 0; k < 3; ++k) imu << ',' << s.gyro[k];
+      for (int k = 0; k < 3; ++k) imu << ',' << s.accel[k];
+      imu << '\n';
+    }
+    char name[32];
+    std::snprintf(name, sizeof(name), "scans/%06zu.bin", n);
+    WriteSimScan((dir / name).string(), frame.cloud);
+    scans << n << ',' << frame.start_ns << ',' << frame.end_ns << ',' << frame.cloud.size() << ','
+          << name << '\n';
+    ++n;
+    if (progress) progress(n, source.NumScans());
+  }
+  if (!imu || !scans) throw std::runtime_error(folder + ": write failed");
+  if (const auto gt = source.GroundTruth()) {
+    std::ofstream out(dir / "ground_truth.csv");
+    out << "t_ns,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
+    for (const auto& p : *gt) {
+      const Eigen::Quaterniond q = p.pose.quaternion();
+      const Vec3& r = p.pose.translation();
+      out << p.t_ns << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ',' << q.y()
+          << ',' << q.z() << ',' << q.w() << '\n';
+    }
+    WriteTum((dir / "ground_truth_tum.txt").string(), *gt);
+  }
+  return n;
+}
+
+}  // namespace ctlio::io
