@@ -1,0 +1,77 @@
+// Continuous-time point-to-plane residual of one lidar point measured at time τ between two
+// knots (SPEC §4):
+//
+//   e = w · nᵀ (p_ref − T_mr(τ) q),   T_mr(τ) = T_rm(τ)⁻¹,
+//
+// where T_rm(τ) is the GP interpolation of SPEC §2 between knots k and k+1. The interpolation
+// and its Jacobians come from gp::GpInterpolator (the one place that forms a state between
+// knots); this factor only chains de/dδT(τ) (point_to_plane.h) onto the knots:
+//
+//   de/d[δT_k, δϖ_k, δϖ̇_k] = de/dδT(τ) · ∂δT(τ)/∂(knot k)   (1×6 · 6×18), same for k+1.
+//
+// One residual per point: points sharing a timestamp are NOT summed before squaring (SPEC §4).
+// Parameter blocks: pose_k (7, PoseManifold), ϖ_k (6), ϖ̇_k (6), pose_k+1, ϖ_k+1, ϖ̇_k+1.
+// The weight w is part of the association; a robust loss is the caller's choice.
+#pragma once
+
+#include <ceres/sized_cost_function.h>
+
+#include <memory>
+#include <utility>
+
+#include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/lidar/point_to_plane.h"
+
+namespace ctlio {
+
+class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6, 7, 6, 6> {
+ public:
+  // `interpolator` is built for this point's τ and the knots' times; points that share a time
+  // may share one interpolator (it is immutable).
+  ContinuousPointToPlane(std::shared_ptr<const gp::GpInterpolator> interpolator,
+                         const PlaneAssociation& association)
+      : interpolator_(std::move(interpolator)), m_(association) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
+    const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
+    const bool want_k =
+        jacobians != nullptr &&
+        (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr);
+    const bool want_k1 =
+        jacobians != nullptr &&
+        (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
+    SE3 T_rm_tau;
+    gp::PoseJacobian J_k, J_k1;
+    interpolator_->Pose(k, k1, &T_rm_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
+    if (!want_k && !want_k1) {
+      residuals[0] = lidar::PointToPlaneError(T_rm_tau, m_, nullptr);
+      return true;
+    }
+    Eigen::Matrix<double, 1, 6> J_tau;
+    residuals[0] = lidar::PointToPlaneError(T_rm_tau, m_, &J_tau);
+    if (want_k) WriteKnotJacobians(J_tau * J_k, parameters[0], jacobians);
+    if (want_k1) WriteKnotJacobians(J_tau * J_k1, parameters[3], jacobians + 3);
+    return true;
+  }
+
+  const PlaneAssociation& association() const { return m_; }
+  const gp::GpInterpolator& interpolator() const { return *interpolator_; }
+
+ private:
+  // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks.
+  static void WriteKnotJacobians(const Eigen::Matrix<double, 1, 18>& J, const double* pose,
+                                 double** out) {
+    if (out[0] != nullptr) LiftPoseJacobian<1>(J.leftCols<6>(), pose, out[0]);
+    using Row6 = Eigen::Map<Eigen::Matrix<double, 1, 6>>;
+    if (out[1] != nullptr) Row6{out[1]} = J.middleCols<6>(6);
+    if (out[2] != nullptr) Row6{out[2]} = J.rightCols<6>();
+  }
+
+  std::shared_ptr<const gp::GpInterpolator> interpolator_;
+  PlaneAssociation m_;
+};
+
+}  // namespace ctlio

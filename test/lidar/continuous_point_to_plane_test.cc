@@ -1,0 +1,202 @@
+// ContinuousPointToPlane (SPEC §4): its residual is the single-pose residual at the GP-
+// interpolated pose, and its Jacobians onto both knots (pose, ϖ, ϖ̇) match numeric
+// differentiation at random, large-rotation and near-identity knots, for WNOJ and Singer.
+#include "ctlio/factors/lidar/continuous_point_to_plane.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "common/gradient_check.h"
+
+namespace ctlio {
+namespace {
+
+using testing::PoseParameters;
+using testing::RandomPose;
+using testing::RandomVec6;
+
+// GradientChecker (tangent-space Jacobians via the manifolds, Ridders' central differences) with
+// an absolute-plus-block-relative criterion. The plain per-entry relative error of
+// JacobiansMatchNumeric is meaningless here: at τ = t_k or t_{k+1} one knot's Jacobian is
+// exactly zero, and the ϖ̇ blocks scale with (τ − t)² ≈ 1e-9…1e-5, so their entries sit near the
+// ~1e-14 noise floor of the numeric derivative. Each entry must satisfy
+//   |J − J_num| ≤ rel · max|J_block| + abs.
+::testing::AssertionResult JacobiansMatchNumericScaled(
+    const ceres::CostFunction& cost, const std::vector<const ceres::Manifold*>& manifolds,
+    std::vector<const double*> parameters, double rel = 1e-7, double abs = 1e-12) {
+  ceres::NumericDiffOptions options;
+  options.ridders_relative_initial_step_size = 1e-3;
+  options.max_num_ridders_extrapolations = 10;
+  ceres::GradientChecker checker(&cost, &manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  checker.Probe(parameters.data(), rel, &results);
+  if (!results.return_value) return ::testing::AssertionFailure() << "evaluation failed";
+  double worst = 0.0;
+  for (size_t b = 0; b < results.local_jacobians.size(); ++b) {
+    const auto& J = results.local_jacobians[b];
+    const auto& Jn = results.local_numeric_jacobians[b];
+    const double bound = rel * J.cwiseAbs().maxCoeff() + abs;
+    const double err = (J - Jn).cwiseAbs().maxCoeff();
+    worst = std::max(worst, err / bound);
+    if (err > bound) {
+      return ::testing::AssertionFailure()
+             << "block " << b << ": max |J - J_num| = " << err << " > " << bound
+             << "\nJ     = " << J << "\nJ_num = " << Jn;
+    }
+  }
+  return ::testing::AssertionSuccess() << "worst error/bound " << worst;
+}
+
+PlaneAssociation RandomAssociation(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  PlaneAssociation m;
+  m.point_robot = 20.0 * Vec3(u(rng), u(rng), u(rng));
+  m.plane_point = 20.0 * Vec3(u(rng), u(rng), u(rng));
+  m.plane_normal = Vec3(u(rng), u(rng), u(rng)).normalized();
+  m.weight = 0.1 + 0.9 * std::abs(u(rng));
+  return m;
+}
+
+gp::SingerModel<6> Model(bool singer) {
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;  // SPEC §4, Newer College
+  alpha << 0, 0, 0, 100, 100, 100;
+  if (!singer) alpha.setZero();
+  return gp::SingerModel<6>(qc, alpha);
+}
+
+struct Knots {
+  std::vector<double> pose_k, pose_k1;
+  Vec6 w_k, dw_k, w_k1, dw_k1;
+  std::vector<const double*> Params() const {
+    return {pose_k.data(), w_k.data(), dw_k.data(), pose_k1.data(), w_k1.data(), dw_k1.data()};
+  }
+};
+
+// Knot k random (rotation up to max_angle); knot k+1 = a motion of up to max_step from it.
+Knots RandomKnots(std::mt19937& rng, double max_angle, double max_step, double velocity_scale) {
+  Knots s;
+  const SE3 T_k = RandomPose(rng, max_angle, 10.0);
+  const SE3 T_k1 = RandomPose(rng, max_step, max_step) * T_k;
+  s.pose_k = PoseParameters(T_k);
+  s.pose_k1 = PoseParameters(T_k1);
+  s.w_k = RandomVec6(rng, velocity_scale);
+  s.dw_k = RandomVec6(rng, 5.0 * velocity_scale);
+  s.w_k1 = RandomVec6(rng, velocity_scale);
+  s.dw_k1 = RandomVec6(rng, 5.0 * velocity_scale);
+  return s;
+}
+
+TEST(ContinuousPointToPlane, ResidualIsSinglePoseResidualAtInterpolatedPose) {
+  std::mt19937 rng(31);
+  const auto model = Model(true);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Knots s = RandomKnots(rng, 3.0, 0.5, 2.0);
+    const double tau = 0.1 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    auto interp = std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, tau);
+    const PlaneAssociation m = RandomAssociation(rng);
+    const ContinuousPointToPlane cost(interp, m);
+    double r = 0.0;
+    ASSERT_TRUE(cost.Evaluate(s.Params().data(), &r, nullptr));
+    SE3 T_tau;
+    interp->Pose(gp::ReadKnotState(s.pose_k.data(), s.w_k.data(), s.dw_k.data()),
+                 gp::ReadKnotState(s.pose_k1.data(), s.w_k1.data(), s.dw_k1.data()), &T_tau,
+                 nullptr, nullptr);
+    const Vec3 p = T_tau.Inverse() * m.point_robot;
+    EXPECT_NEAR(r, m.weight * m.plane_normal.dot(m.plane_point - p), 1e-9);
+  }
+}
+
+// At the knot times the interpolated pose is the knot pose, so the residual equals the
+// single-pose factor's.
+TEST(ContinuousPointToPlane, AtKnotTimesEqualsSinglePoseFactor) {
+  std::mt19937 rng(32);
+  const auto model = Model(true);
+  const Knots s = RandomKnots(rng, 3.0, 0.5, 2.0);
+  const PlaneAssociation m = RandomAssociation(rng);
+  for (const auto& [tau, pose] :
+       {std::make_pair(0.0, s.pose_k.data()), std::make_pair(0.1, s.pose_k1.data())}) {
+    const ContinuousPointToPlane cost(
+        std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, tau), m);
+    const PointToPlane single(m);
+    double r = 0.0, r_single = 1.0;
+    ASSERT_TRUE(cost.Evaluate(s.Params().data(), &r, nullptr));
+    const double* p[] = {pose};
+    ASSERT_TRUE(single.Evaluate(p, &r_single, nullptr));
+    EXPECT_NEAR(r, r_single, 1e-9) << tau;
+  }
+}
+
+void CheckJacobians(bool singer, double max_angle, double max_step, double velocity_scale,
+                    uint32_t seed) {
+  std::mt19937 rng(seed);
+  const auto model = Model(singer);
+  const PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, nullptr,
+                                                         &pose_manifold, nullptr, nullptr};
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Knots s = RandomKnots(rng, max_angle, max_step, velocity_scale);
+    const double tau = trial == 0 ? 0.0 : (trial == 1 ? 0.1 : 0.1 * u(rng));
+    const ContinuousPointToPlane cost(
+        std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, tau), RandomAssociation(rng));
+    EXPECT_TRUE(JacobiansMatchNumericScaled(cost, manifolds, s.Params()))
+        << "trial " << trial << " tau " << tau;
+  }
+}
+
+TEST(ContinuousPointToPlane, JacobiansRandomKnotsSinger) {
+  CheckJacobians(true, M_PI, 0.5, 2.0, 33);
+}
+TEST(ContinuousPointToPlane, JacobiansRandomKnotsWnoj) {
+  CheckJacobians(false, M_PI, 0.5, 2.0, 34);
+}
+TEST(ContinuousPointToPlane, JacobiansLargeMotion) { CheckJacobians(true, M_PI, 2.5, 10.0, 35); }
+TEST(ContinuousPointToPlane, JacobiansNearIdentity) { CheckJacobians(true, 1e-7, 1e-7, 1e-7, 36); }
+
+TEST(ContinuousPointToPlane, JacobiansKnotNearPi) {
+  std::mt19937 rng(37);
+  const auto model = Model(true);
+  const PoseManifold pose_manifold;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, nullptr,
+                                                         &pose_manifold, nullptr, nullptr};
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    Knots s = RandomKnots(rng, 1.0, 0.3, 1.0);
+    const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const SE3 T_k(so3::Exp((M_PI - 1e-6) * axis), Vec3(1.0, 2.0, 3.0));
+    s.pose_k = PoseParameters(T_k);
+    s.pose_k1 = PoseParameters(RandomPose(rng, 0.3, 0.3) * T_k);
+    const ContinuousPointToPlane cost(
+        std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.1 * std::abs(u(rng))),
+        RandomAssociation(rng));
+    EXPECT_TRUE(JacobiansMatchNumericScaled(cost, manifolds, s.Params())) << trial;
+  }
+}
+
+// Ceres may ask for any subset of the Jacobians: each must equal the full evaluation's.
+TEST(ContinuousPointToPlane, PartialJacobianRequests) {
+  std::mt19937 rng(38);
+  const auto model = Model(true);
+  const Knots s = RandomKnots(rng, 2.0, 0.5, 2.0);
+  const ContinuousPointToPlane cost(
+      std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.037), RandomAssociation(rng));
+  double full[6][7], part[6][7];
+  double* full_ptrs[6];
+  for (int i = 0; i < 6; ++i) full_ptrs[i] = full[i];
+  double r_full, r_part;
+  ASSERT_TRUE(cost.Evaluate(s.Params().data(), &r_full, full_ptrs));
+  for (int only = 0; only < 6; ++only) {
+    double* ptrs[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+    ptrs[only] = part[only];
+    ASSERT_TRUE(cost.Evaluate(s.Params().data(), &r_part, ptrs));
+    EXPECT_EQ(r_part, r_full);
+    const int n = (only % 3 == 0) ? 7 : 6;
+    for (int j = 0; j < n; ++j) EXPECT_EQ(part[only][j], full[only][j]) << only << " " << j;
+  }
+}
+
+}  // namespace
+}  // namespace ctlio
