@@ -27,7 +27,7 @@ TEST(BiasRandomWalk, CovarianceScalesWithDt) {
 // Scaling by Δt makes the model independent of the knot rate: a linear bias
 // drift over 1 s (the most likely path between its two ends) costs the same
 // whether the chain has 2 or 10 knots. A fixed per-knot covariance would make
-// the 10-knot chain 9² times cheaper... here the costs agree to round-off.
+// the 10-knot chain 9 times cheaper; here the costs agree to round-off.
 TEST(BiasRandomWalk, ChainCostIndependentOfKnotRate) {
   const double qa = 9e-6, qg = 3.76e-10;
   Vec6 start = Vec6::Zero(), end;

@@ -1,0 +1,140 @@
+#include "ctlio/factors/imu/imu_measurement.h"
+
+#include <Eigen/Cholesky>
+#include <stdexcept>
+
+#include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/manifolds/rotation_manifold.h"
+
+namespace ctlio::imu {
+namespace {
+
+using Row3x18 = Eigen::Matrix<double, 3, 18>;
+using Jac3x6 = Eigen::Matrix<double, 3, 6, Eigen::RowMajor>;
+
+double Fraction(double t_k, double t_k1, double tau) { return (tau - t_k) / (t_k1 - t_k); }
+
+// Writes D·J (3×18) of one knot into its pose (lifted), ϖ and ϖ̇ blocks.
+void WriteKnotJacobians(const Row3x18& DJ, const double* pose, double* j_pose, double* j_vel,
+                        double* j_acc) {
+  if (j_pose != nullptr) LiftPoseJacobian<3>(DJ.leftCols<6>(), pose, j_pose);
+  if (j_vel != nullptr) Eigen::Map<Jac3x6>{j_vel} = DJ.middleCols<6>(6);
+  if (j_acc != nullptr) Eigen::Map<Jac3x6>{j_acc} = DJ.rightCols<6>();
+}
+
+}  // namespace
+
+Mat3 SqrtInformation(const Mat3& covariance) {
+  const Eigen::LLT<Mat3> llt(covariance);
+  if (!covariance.allFinite() || llt.info() != Eigen::Success) {
+    throw std::invalid_argument("IMU measurement: covariance is not positive definite");
+  }
+  return llt.matrixL().solve(Mat3::Identity());
+}
+
+ImuGyroMeasurement::ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                                       double tau, const Vec3& gyro, const Mat3& covariance)
+    : interpolator_(model, t_k, t_k1, tau),
+      s_(Fraction(t_k, t_k1, tau)),
+      gyro_(gyro),
+      sqrt_information_(SqrtInformation(covariance)) {}
+
+bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
+  const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
+  const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
+  const bool need_knots =
+      jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr ||
+                               jacobians[2] != nullptr || jacobians[3] != nullptr ||
+                               jacobians[4] != nullptr || jacobians[5] != nullptr);
+  gp::KnotState x;
+  gp::StateJacobian J_k, J_k1;
+  interpolator_.State(k, k1, &x, need_knots ? &J_k : nullptr, need_knots ? &J_k1 : nullptr);
+
+  const Vec3 bg = (1.0 - s_) * b_k.tail<3>() + s_ * b_k1.tail<3>();
+  Eigen::Map<Vec3>{residuals} = sqrt_information_ * (gyro_ + x.velocity.tail<3>() - bg);
+  if (jacobians == nullptr) return true;
+
+  if (need_knots) {
+    // D = [0 … I at ϖ_ω … 0]: rows 9–11 of the state Jacobians.
+    const Row3x18 DJ_k = sqrt_information_ * J_k.middleRows<3>(9);
+    const Row3x18 DJ_k1 = sqrt_information_ * J_k1.middleRows<3>(9);
+    WriteKnotJacobians(DJ_k, parameters[0], jacobians[0], jacobians[1], jacobians[2]);
+    WriteKnotJacobians(DJ_k1, parameters[3], jacobians[3], jacobians[4], jacobians[5]);
+  }
+  for (int i = 0; i < 2; ++i) {
+    if (jacobians[6 + i] == nullptr) continue;
+    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
+    J.leftCols<3>().setZero();
+    J.rightCols<3>() = -(i == 0 ? 1.0 - s_ : s_) * sqrt_information_;
+  }
+  return true;
+}
+
+ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k,
+                                         double t_k1, double tau, const Vec3& accel,
+                                         const Mat3& covariance, double gravity,
+                                         AccelModel accel_model)
+    : interpolator_(model, t_k, t_k1, tau),
+      s_(Fraction(t_k, t_k1, tau)),
+      accel_(accel),
+      sqrt_information_(SqrtInformation(covariance)),
+      gravity_i_(0.0, 0.0, -gravity),
+      accel_model_(accel_model) {}
+
+bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
+  const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
+  const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
+  const Mat3 C_mi = RotationManifold::Rotation(parameters[8]);
+  bool need_knots = false;
+  if (jacobians != nullptr) {
+    for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
+  }
+  gp::KnotState x;
+  gp::StateJacobian J_k, J_k1;
+  interpolator_.State(k, k1, &x, need_knots ? &J_k : nullptr, need_knots ? &J_k1 : nullptr);
+
+  const Mat3& C = x.pose.rotation();  // C_rm(τ)
+  const Vec3 g_m = C_mi * gravity_i_;
+  const Vec3 g_r = C * g_m;
+  const Vec3 w_v = x.velocity.head<3>(), w_w = x.velocity.tail<3>();
+  const Vec3 ba = (1.0 - s_) * b_k.head<3>() + s_ * b_k1.head<3>();
+  Vec3 e = accel_ + x.acceleration.head<3>() + g_r - ba;
+  const bool exact = accel_model_ == AccelModel::kSpecificForce;
+  if (exact) e -= w_w.cross(w_v);
+  Eigen::Map<Vec3>{residuals} = sqrt_information_ * e;
+  if (jacobians == nullptr) return true;
+
+  if (need_knots) {
+    // D·J = −(g_r)^·J[δφ rows] + J[ϖ̇_v rows] (− ϖ_ω^ J[ϖ_v rows] + ϖ_v^ J[ϖ_ω rows]).
+    const Mat3 G = -so3::Hat(g_r);
+    const auto chain = [&](const gp::StateJacobian& J) {
+      Row3x18 DJ = J.middleRows<3>(12);
+      DJ.noalias() += G * J.middleRows<3>(3);
+      if (exact) {
+        DJ.noalias() -= so3::Hat(w_w) * J.middleRows<3>(6);
+        DJ.noalias() += so3::Hat(w_v) * J.middleRows<3>(9);
+      }
+      return Row3x18(sqrt_information_ * DJ);
+    };
+    WriteKnotJacobians(chain(J_k), parameters[0], jacobians[0], jacobians[1], jacobians[2]);
+    WriteKnotJacobians(chain(J_k1), parameters[3], jacobians[3], jacobians[4], jacobians[5]);
+  }
+  for (int i = 0; i < 2; ++i) {
+    if (jacobians[6 + i] == nullptr) continue;
+    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
+    J.leftCols<3>() = -(i == 0 ? 1.0 - s_ : s_) * sqrt_information_;
+    J.rightCols<3>().setZero();
+  }
+  if (jacobians[8] != nullptr) {
+    const Mat3 J_psi = -sqrt_information_ * C * so3::Hat(g_m);
+    LiftRotationJacobian<3>(J_psi, parameters[8], jacobians[8]);
+  }
+  return true;
+}
+
+}  // namespace ctlio::imu
