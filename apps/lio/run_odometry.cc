@@ -1,0 +1,162 @@
+#include "run_odometry.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+
+#include "ctlio/solvers/lio/lio_odometry.h"
+
+namespace ctlio::lioapp {
+
+long PeakRssKb() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return 0;
+}
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double idx = p * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(idx));
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (idx - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
+                      const std::vector<io::StampedPose>& truth) {
+  AteResult r;
+  if (truth.size() < 2) return r;
+  std::vector<Vec3> est, ref;
+  for (const io::StampedPose& e : estimate) {
+    const auto it =
+        std::lower_bound(truth.begin(), truth.end(), e.t_ns,
+                         [](const io::StampedPose& p, int64_t t) { return p.t_ns < t; });
+    Vec3 p;
+    if (it != truth.end() && std::llabs(it->t_ns - e.t_ns) <= 1000000) {
+      p = it->pose.translation();
+    } else if (it != truth.begin() && it != truth.end() && it->t_ns - (it - 1)->t_ns < 200000000) {
+      const double s = double(e.t_ns - (it - 1)->t_ns) / double(it->t_ns - (it - 1)->t_ns);
+      p = (1 - s) * (it - 1)->pose.translation() + s * it->pose.translation();
+    } else if (it != truth.begin() && std::llabs((it - 1)->t_ns - e.t_ns) <= 1000000) {
+      p = (it - 1)->pose.translation();
+    } else {
+      continue;
+    }
+    est.push_back(e.pose.translation());
+    ref.push_back(p);
+  }
+  r.pairs = est.size();
+  if (est.size() < 3) return r;
+  Eigen::Matrix3Xd A(3, est.size()), B(3, est.size());
+  for (size_t i = 0; i < est.size(); ++i) {
+    A.col(i) = est[i];
+    B.col(i) = ref[i];
+  }
+  // SE(3) alignment (no scale): Umeyama (1991) as implemented by Eigen.
+  const Eigen::Matrix4d T = Eigen::umeyama(A, B, false);
+  double sum2 = 0.0;
+  for (size_t i = 0; i < est.size(); ++i) {
+    const double e =
+        (T.topLeftCorner<3, 3>() * A.col(i) + T.topRightCorner<3, 1>() - B.col(i)).norm();
+    sum2 += e * e;
+    r.mean += e;
+    r.max = std::max(r.max, e);
+  }
+  r.rmse = std::sqrt(sum2 / double(est.size()));
+  r.mean /= double(est.size());
+  return r;
+}
+
+RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
+                       const RunOptions& options, double failure_ate) {
+  // The source knows its sensor setup; it overrides the config's.
+  config.T_imu_lidar = source.ImuFromLidar();
+  if (const auto g = source.Gravity()) config.gravity = *g;
+  auto odometry = lio::MakeLioOdometry(config);
+  RunSummary run;
+  run.method = lio::LioMethodName(config.method);
+  run.source = source.Name();
+  const SE3 T_imu_lidar = config.T_imu_lidar;
+  const size_t total = options.max_scans > 0
+                           ? (source.NumScans() > 0 ? std::min(options.max_scans, source.NumScans())
+                                                    : options.max_scans)
+                           : source.NumScans();
+  io::ScanFrame frame;
+  std::vector<double> ms;
+  size_t done = 0;
+  while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
+    for (const io::ImuSample& s : frame.imu) {
+      lio::ImuSample x;
+      x.t_ns = s.t_ns;
+      x.gyro = s.gyro;
+      x.accel = s.accel;
+      odometry->AddImu(x);
+    }
+    lio::LidarScan scan;
+    scan.begin_ns = frame.start_ns;
+    scan.end_ns = frame.end_ns;
+    scan.points = std::move(frame.cloud.points);
+    scan.times_ns = std::move(frame.cloud.times_ns);
+    if (scan.times_ns.empty()) scan.times_ns.assign(scan.points.size(), scan.end_ns);
+    const lio::ScanResult r = odometry->AddScan(scan);
+    ++done;
+    ms.push_back(r.milliseconds);
+    switch (r.status) {
+      case lio::ScanStatus::kFailed:
+        if (odometry->initialised() || done > 1) {
+          ++run.failed;
+          if (run.first_failure.empty()) run.first_failure = r.message;
+        }
+        break;
+      case lio::ScanStatus::kDegenerate:
+        ++run.degenerate;
+        break;
+      case lio::ScanStatus::kImuGap:
+        ++run.imu_gaps;
+        break;
+      default:
+        break;
+    }
+    if (r.status != lio::ScanStatus::kFailed) {
+      run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
+    }
+    run.scans.push_back(r);
+    if (options.progress) options.progress(done, total, r);
+  }
+  // The first scan (map creation) is not a registration: keep it out of the latency figures.
+  std::vector<double> reg(ms.begin() + std::min<size_t>(1, ms.size()), ms.end());
+  run.median_ms = Percentile(reg, 0.5);
+  run.p95_ms = Percentile(reg, 0.95);
+  run.max_ms = reg.empty() ? 0.0 : *std::max_element(reg.begin(), reg.end());
+  run.peak_rss_kb = PeakRssKb();
+  if (const auto truth = source.GroundTruth()) {
+    run.ate = EvaluateAte(run.trajectory, *truth);
+  }
+  run.failure =
+      run.failed > 0 || (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
+  return run;
+}
+
+void WriteScanLog(const std::string& path, const RunSummary& run) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot write the scan log");
+  f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
+       "ms x y z message\n";
+  f << std::setprecision(12);
+  for (const lio::ScanResult& r : run.scans) {
+    const Vec3 p = r.T_mr.translation();
+    f << 1e-9 * double(r.t_ns) << ' ' << lio::ScanStatusName(r.status) << ' ' << r.keypoints << ' '
+      << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds << ' ' << r.solver_iterations
+      << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << p.x() << ' ' << p.y() << ' '
+      << p.z() << ' ' << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+  }
+}
+
+}  // namespace ctlio::lioapp

@@ -1,0 +1,62 @@
+// Runs a LIO pipeline over a dataset source (a reader or the in-memory simulator): feeds the IMU
+// and the scans, collects the per-scan log and the trajectory, times every scan, and evaluates
+// against the ground truth when the source has it. Shared by ctlio_odometry and
+// ctlio_experiment.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ctlio/io/dataset.h"
+#include "ctlio/solvers/lio/odometry_config.h"
+
+namespace ctlio::lioapp {
+
+struct RunOptions {
+  size_t max_scans = 0;  // 0 = all
+  // Called after every scan with (scans done, scans total or 0, the scan's result).
+  std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
+};
+
+struct AteResult {
+  double rmse = 0.0;  // m, after SE(3) Umeyama alignment
+  double mean = 0.0;
+  double max = 0.0;
+  size_t pairs = 0;
+};
+
+struct RunSummary {
+  std::string method;
+  std::string source;
+  // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
+  // estimated (failed scans are left out, never written as garbage).
+  std::vector<io::StampedPose> trajectory;
+  std::vector<lio::ScanResult> scans;
+  int failed = 0, degenerate = 0, imu_gaps = 0;
+  std::string first_failure;  // message of the first failed scan
+  double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
+  long peak_rss_kb = 0;          // process-wide high-water mark (VmHWM) at the end of the run
+  std::optional<AteResult> ate;  // when the source has ground truth
+  // The run is a failure if a scan failed after initialisation or the ATE exceeds
+  // `failure_ate` (the estimate left the room of any sensible error).
+  bool failure = false;
+};
+
+RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
+                       const RunOptions& options = {}, double failure_ate = 1.0);
+
+// ATE of `estimate` against `truth` (time association within 1 ms; truth interpolated between
+// its two nearest poses), SE(3) Umeyama alignment.
+AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
+                      const std::vector<io::StampedPose>& truth);
+
+// Per-scan log: t, status, keypoints, associations, imu residuals, rounds, solver iterations,
+// final cost, ms, position, message.
+void WriteScanLog(const std::string& path, const RunSummary& run);
+
+long PeakRssKb();
+double Percentile(std::vector<double> v, double p);
+
+}  // namespace ctlio::lioapp

@@ -1,0 +1,128 @@
+// Configuration and input/output types of the lidar-inertial odometry pipelines (SPEC §4–§6):
+// Singer-LIO (IMU as a measurement; lidar_gyro and lidar_only variants) and the IMU-as-input
+// baseline. data/sim_lio.yaml and data/newer_college_lio.yaml document every key.
+//
+// Frames: the robot frame r IS the IMU frame; lidar points are moved into it with the extrinsic
+// T_imu_lidar on arrival. The map frame m is the robot frame at the first scan's start, and
+// C_mi rotates the gravity-aligned frame i (g_i = [0, 0, −g]) into m (gravity initialisation).
+// Times: int64 ns at the interface (SPEC §1), double seconds relative to the first scan inside.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ctlio/manifolds/se3.h"
+#include "ctlio/manifolds/types.h"
+#include "ctlio/solvers/lio/lidar_frontend_options.h"
+
+namespace YAML {
+class Node;
+}
+
+namespace ctlio::lio {
+
+enum class LioMethod {
+  kSingerLio,  // GP (Singer) prior, lidar + gyro + accelerometer as measurements, biases
+  kLidarGyro,  // same without the accelerometer
+  kLidarOnly,  // GP prior + lidar only
+  kImuInput,   // baseline: preintegrated IMU between scan-time states, IMU-integrated deskew
+};
+LioMethod ParseLioMethod(const std::string& name);  // throws std::invalid_argument
+std::string LioMethodName(LioMethod method);
+
+struct OdometryConfig {
+  LioMethod method = LioMethod::kSingerLio;
+  LidarFrontendOptions frontend;
+
+  // --- GP prior (Singer), per axis in [ρ; φ] order (SPEC §2, §4). Qc per second.
+  Vec6 qc = (Vec6() << 5000, 5000, 5000, 500, 500, 500).finished();
+  Vec6 alpha = (Vec6() << 0, 0, 0, 100, 100, 100).finished();
+
+  // --- IMU noise (SPEC §4 defaults: the paper's Newer College values).
+  double accel_variance = 0.156;    // (m/s²)², whitened error under a Cauchy loss
+  double accel_loss_scale = 1.0;    // Cauchy scale on the whitened accelerometer error; 0 = none
+  double gyro_variance = 4.326e-4;  // (rad/s)²
+  // Bias random walk: variance accumulated per `bias_walk_period` seconds (the paper's per 0.1 s);
+  // scaled by Δt between knots (SPEC §3) — the reference code does not scale it.
+  double bias_accel_walk = 1.1236e-2;
+  double bias_gyro_walk = 1.6e-4;
+  double bias_walk_period = 0.1;
+  double initial_bias_accel_variance = 0.1;
+  double initial_bias_gyro_variance = 0.01;
+  double gravity = 9.81599;
+  // Exact specific force (with ω×v) instead of the paper's body-centric accelerometer model.
+  bool exact_specific_force = false;
+  // IMU-input baseline: per-sample standard deviations of the IMU at imu_rate_hint; the
+  // preintegration uses the continuous densities σ/√rate.
+  double input_accel_sigma = 0.02;  // m/s², per sample at rate_hint
+  double input_gyro_sigma = 0.01;   // rad/s, per sample at rate_hint
+  double imu_rate_hint = 200.0;     // Hz, for the densities above
+
+  // --- Lidar residual: the point-to-plane error (already weighted by the planarity weight) is
+  // divided by this standard deviation so that it is commensurate with the whitened IMU and
+  // prior terms; the front end's loss scale stays in metres.
+  double point_to_plane_std = 0.05;  // m
+
+  // --- Initialisation and robustness.
+  double gravity_init_duration = 0.2;  // s of accelerometer averaged while still at start
+  double gravity_init_max_std = 0.5;   // m/s²: "still enough" threshold on the accel spread
+  // A scan whose keypoints produce fewer than this many plane associations is degenerate: the
+  // lidar term is dropped for it (the prior + IMU carry the state) and the scan is flagged.
+  int min_associations = 50;
+  double max_imu_gap = 0.05;  // s; a longer hole in the IMU stream is reported per scan
+  // A scan is a failure if the pose jumps more than this between consecutive scans (m).
+  double max_scan_translation = 5.0;
+
+  // --- Window and solver.
+  int window_knots = 2;    // newest knots kept free (SPEC §4: 2, the one before held)
+  int solver_threads = 1;  // Ceres threads (iterations per round: lidar_frontend.solver_iterations)
+  bool estimate_gravity = false;  // hold C_mi after initialisation (paper) or refine it
+
+  // --- Sensor setup.
+  SE3 T_imu_lidar;  // lidar → robot (IMU) frame
+
+  void Validate() const;  // throws std::invalid_argument naming the bad field
+};
+
+// Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
+// `lidar_frontend`. Missing keys keep their defaults; unknown keys and bad values throw
+// std::runtime_error naming file and line.
+OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string& source);
+OdometryConfig LoadOdometryConfig(const std::string& path);
+
+// --- Pipeline input (what a dataset reader or the simulator hands over, converted by the app).
+struct ImuSample {
+  int64_t t_ns = 0;
+  Vec3 gyro = Vec3::Zero();   // rad/s, IMU frame
+  Vec3 accel = Vec3::Zero();  // m/s² (specific force), IMU frame
+};
+
+struct LidarScan {
+  int64_t begin_ns = 0;           // first firing
+  int64_t end_ns = 0;             // last firing: the knot time of this scan
+  std::vector<Vec3> points;       // lidar frame
+  std::vector<int64_t> times_ns;  // absolute per-point times, same size as points
+};
+
+// --- Pipeline output, one per scan.
+enum class ScanStatus { kOk, kInitialising, kDegenerate, kImuGap, kFailed };
+const char* ScanStatusName(ScanStatus status);
+
+struct ScanResult {
+  int64_t t_ns = 0;              // scan end (knot time)
+  SE3 T_mr;                      // robot pose in the map (T_rm⁻¹) at t_ns
+  Vec6 velocity = Vec6::Zero();  // [v; ω] body frame (Singer: −ϖ; baseline: C_rmᵀ v_m)
+  Vec6 bias = Vec6::Zero();      // [b_a; b_g]
+  ScanStatus status = ScanStatus::kOk;
+  std::string message;  // why, for anything but kOk
+  int keypoints = 0;
+  int associations = 0;  // lidar residuals in the final round
+  int imu_residuals = 0;
+  int rounds = 0;  // re-association rounds
+  int solver_iterations = 0;
+  double final_cost = 0.0;
+  double milliseconds = 0.0;  // wall time of this scan
+};
+
+}  // namespace ctlio::lio

@@ -1,0 +1,226 @@
+#include "ctlio/solvers/lio/odometry_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace ctlio::lio {
+
+namespace {
+
+std::string Where(const std::string& source, const YAML::Mark& mark) {
+  std::ostringstream s;
+  s << source;
+  if (mark.line >= 0) s << ":" << mark.line + 1;
+  return s.str();
+}
+
+using Setter = std::function<void(const YAML::Node&)>;
+
+template <typename T>
+Setter Set(T* field) {
+  return [field](const YAML::Node& v) { *field = v.as<T>(); };
+}
+
+Setter SetVec6(Vec6* field) {
+  return [field](const YAML::Node& v) {
+    if (!v.IsSequence() || v.size() != 6) throw YAML::Exception(v.Mark(), "need 6 numbers");
+    for (int i = 0; i < 6; ++i) (*field)[i] = v[i].as<double>();
+  };
+}
+
+// Applies `fields` to the mapping `node` (section `section` of `source`).
+void ReadSection(const YAML::Node& node, const std::string& section, const std::string& source,
+                 const std::map<std::string, Setter>& fields) {
+  if (!node.IsDefined() || node.IsNull()) return;
+  if (!node.IsMap()) {
+    throw std::runtime_error(Where(source, node.Mark()) + ": '" + section +
+                             "' must be a YAML mapping");
+  }
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    const auto it = fields.find(key);
+    if (it == fields.end()) {
+      throw std::runtime_error(Where(source, kv.first.Mark()) + ": unknown key '" + section + "." +
+                               key + "'");
+    }
+    try {
+      it->second(kv.second);
+    } catch (const YAML::Exception&) {
+      throw std::runtime_error(Where(source, kv.second.Mark()) + ": bad value for '" + section +
+                               "." + key + "'");
+    }
+  }
+}
+
+}  // namespace
+
+LioMethod ParseLioMethod(const std::string& name) {
+  if (name == "singer_lio") return LioMethod::kSingerLio;
+  if (name == "lidar_gyro") return LioMethod::kLidarGyro;
+  if (name == "lidar_only") return LioMethod::kLidarOnly;
+  if (name == "imu_input") return LioMethod::kImuInput;
+  throw std::invalid_argument("unknown method '" + name +
+                              "' (singer_lio, lidar_gyro, lidar_only, imu_input)");
+}
+
+std::string LioMethodName(LioMethod method) {
+  switch (method) {
+    case LioMethod::kSingerLio:
+      return "singer_lio";
+    case LioMethod::kLidarGyro:
+      return "lidar_gyro";
+    case LioMethod::kLidarOnly:
+      return "lidar_only";
+    case LioMethod::kImuInput:
+      return "imu_input";
+  }
+  return "?";
+}
+
+const char* ScanStatusName(ScanStatus status) {
+  switch (status) {
+    case ScanStatus::kOk:
+      return "ok";
+    case ScanStatus::kInitialising:
+      return "initialising";
+    case ScanStatus::kDegenerate:
+      return "degenerate";
+    case ScanStatus::kImuGap:
+      return "imu_gap";
+    case ScanStatus::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+void OdometryConfig::Validate() const {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("OdometryConfig: ") + what);
+  };
+  frontend.Validate();
+  require((qc.array() > 0).all(), "gp.qc must be positive on every axis");
+  require((alpha.array() >= 0).all(), "gp.alpha must be >= 0 on every axis");
+  require(accel_variance > 0 && gyro_variance > 0, "imu variances must be positive");
+  require(accel_loss_scale >= 0, "imu.accel_loss_scale must be >= 0");
+  require(bias_accel_walk > 0 && bias_gyro_walk > 0 && bias_walk_period > 0,
+          "bias random walk parameters must be positive");
+  require(initial_bias_accel_variance > 0 && initial_bias_gyro_variance > 0,
+          "initial bias variances must be positive");
+  require(gravity > 0, "imu.gravity must be positive");
+  require(input_accel_sigma > 0 && input_gyro_sigma > 0 && imu_rate_hint > 0,
+          "imu input noise densities and rate must be positive");
+  require(gravity_init_duration >= 0 && gravity_init_max_std > 0, "bad init parameters");
+  require(point_to_plane_std > 0, "lidar.point_to_plane_std must be positive");
+  require(min_associations >= 0, "init.min_associations must be >= 0");
+  require(max_imu_gap > 0, "init.max_imu_gap must be positive");
+  require(max_scan_translation > 0, "init.max_scan_translation must be positive");
+  require(window_knots >= 2, "window.knots must be >= 2");
+  require(solver_threads >= 1, "window solver settings must be >= 1");
+}
+
+OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string& source) {
+  OdometryConfig c;
+  if (!root.IsDefined() || root.IsNull()) return c;
+  if (!root.IsMap()) throw std::runtime_error(source + ": the config must be a YAML mapping");
+  std::string method = LioMethodName(c.method);
+  Vec6 extrinsic_xyz_rpy = Vec6::Zero();
+  std::vector<double> extrinsic_rotation;  // optional 3×3 row-major
+  bool have_extrinsic = false;
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node& v = kv.second;
+    if (key == "method") {
+      method = v.as<std::string>();
+    } else if (key == "gp") {
+      ReadSection(v, key, source, {{"qc", SetVec6(&c.qc)}, {"alpha", SetVec6(&c.alpha)}});
+    } else if (key == "imu") {
+      ReadSection(v, key, source,
+                  {{"accel_variance", Set(&c.accel_variance)},
+                   {"accel_loss_scale", Set(&c.accel_loss_scale)},
+                   {"gyro_variance", Set(&c.gyro_variance)},
+                   {"bias_accel_walk", Set(&c.bias_accel_walk)},
+                   {"bias_gyro_walk", Set(&c.bias_gyro_walk)},
+                   {"bias_walk_period", Set(&c.bias_walk_period)},
+                   {"initial_bias_accel_variance", Set(&c.initial_bias_accel_variance)},
+                   {"initial_bias_gyro_variance", Set(&c.initial_bias_gyro_variance)},
+                   {"gravity", Set(&c.gravity)},
+                   {"exact_specific_force", Set(&c.exact_specific_force)},
+                   {"input_accel_sigma", Set(&c.input_accel_sigma)},
+                   {"input_gyro_sigma", Set(&c.input_gyro_sigma)},
+                   {"rate_hint", Set(&c.imu_rate_hint)}});
+    } else if (key == "lidar") {
+      ReadSection(v, key, source, {{"point_to_plane_std", Set(&c.point_to_plane_std)}});
+    } else if (key == "init") {
+      ReadSection(v, key, source,
+                  {{"gravity_duration", Set(&c.gravity_init_duration)},
+                   {"gravity_max_std", Set(&c.gravity_init_max_std)},
+                   {"min_associations", Set(&c.min_associations)},
+                   {"max_imu_gap", Set(&c.max_imu_gap)},
+                   {"max_scan_translation", Set(&c.max_scan_translation)}});
+    } else if (key == "window") {
+      ReadSection(v, key, source,
+                  {{"knots", Set(&c.window_knots)},
+                   {"threads", Set(&c.solver_threads)},
+                   {"estimate_gravity", Set(&c.estimate_gravity)}});
+    } else if (key == "extrinsic") {
+      have_extrinsic = true;
+      ReadSection(v, key, source,
+                  {{"xyz_rpy", SetVec6(&extrinsic_xyz_rpy)},
+                   {"rotation", Set(&extrinsic_rotation)},
+                   {"translation", [&](const YAML::Node& n) {
+                      const auto t = n.as<std::vector<double>>();
+                      if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
+                      extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
+                    }}});
+    } else if (key == "lidar_frontend") {
+      c.frontend = LidarFrontendOptionsFromYaml(v, source);
+    } else {
+      throw std::runtime_error(Where(source, kv.first.Mark()) + ": unknown key '" + key + "'");
+    }
+  }
+  try {
+    c.method = ParseLioMethod(method);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(source + ": " + e.what());
+  }
+  if (have_extrinsic) {
+    Mat3 C;
+    if (!extrinsic_rotation.empty()) {
+      if (extrinsic_rotation.size() != 9)
+        throw std::runtime_error(source + ": extrinsic.rotation needs 9 numbers (row-major)");
+      C = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(extrinsic_rotation.data());
+      if ((C * C.transpose() - Mat3::Identity()).norm() > 1e-6 || C.determinant() < 0)
+        throw std::runtime_error(source + ": extrinsic.rotation is not a rotation matrix");
+    } else {
+      const Vec3 rpy = extrinsic_xyz_rpy.tail<3>();
+      C = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+           Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+              .toRotationMatrix();
+    }
+    c.T_imu_lidar = SE3(C, extrinsic_xyz_rpy.head<3>());
+  }
+  try {
+    c.Validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(source + ": " + e.what());
+  }
+  return c;
+}
+
+OdometryConfig LoadOdometryConfig(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error(path + ": cannot open odometry config");
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(Where(path, e.mark) + ": " + e.msg);
+  }
+  return OdometryConfigFromYaml(root, path);
+}
+
+}  // namespace ctlio::lio
