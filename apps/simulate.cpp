@@ -6,6 +6,7 @@
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -28,6 +29,7 @@ DEFINE_bool(body_centric, false, "Generate the paper's body-centric acceleromete
 DEFINE_double(bias_walk_accel, 0.0, "Accelerometer bias random walk [m/s²/√s]");
 DEFINE_double(bias_walk_gyro, 0.0, "Gyro bias random walk [rad/s/√s]");
 DEFINE_int32(pillars, 0, "Interior 1 m × 1 m pillars placed at random (seeded) in the room");
+DEFINE_bool(ground_truth, true, "Write the ground-truth trajectory");
 DEFINE_bool(newer_college_extrinsic, false,
             "Use the Newer College lidar→IMU extrinsic instead of identity");
 
@@ -78,16 +80,18 @@ int main(int argc, char** argv) {
     std::ostringstream name;
     name << "sim:" << FLAGS_regime << "/" << FLAGS_index;
     sim::SimulatedSource source(config, name.str());
+    // Progress on stderr, about every 5 % of the scans.
     auto progress = [&](size_t done, size_t total) {
+      if (done != total && done % std::max<size_t>(1, total / 20) != 0) return;
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "\rscan %zu/%zu  %.1f s", done, total, s);
-      if (done == total) std::fprintf(stderr, "\n");
+      std::fprintf(stderr, "scan %zu/%zu (%3.0f %%)  %.1f s\n", done, total,
+                   100.0 * double(done) / double(std::max<size_t>(total, 1)), s);
     };
     size_t n = 0;
     if (FLAGS_layout == "ctlio") {
-      n = io::WriteSimFolder(source, FLAGS_output, yaml.str(), progress);
+      n = io::WriteSimFolder(source, FLAGS_output, yaml.str(), progress, FLAGS_ground_truth);
     } else if (FLAGS_layout == "newer_college") {
-      n = io::WriteNewerCollege(source, FLAGS_output, progress);
+      n = io::WriteNewerCollege(source, FLAGS_output, progress, FLAGS_ground_truth);
     } else {
       throw std::runtime_error("unknown --layout '" + FLAGS_layout + "'");
     }

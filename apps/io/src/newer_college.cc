@@ -152,7 +152,8 @@ std::optional<std::vector<StampedPose>> NewerCollegeReader::GroundTruth() const 
 }
 
 size_t WriteNewerCollege(DataSource& source, const std::string& folder,
-                         const std::function<void(size_t, size_t)>& progress) {
+                         const std::function<void(size_t, size_t)>& progress,
+                         bool write_ground_truth) {
   const fs::path seq(folder);
   fs::create_directories(ScanDir(seq));
   fs::create_directories(ImuFile(seq).parent_path());
@@ -177,7 +178,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
     if (progress) progress(n, source.NumScans());
   }
   if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": write failed");
-  if (const auto gt = source.GroundTruth()) {
+  if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
     fs::create_directories(GtFile(seq).parent_path());
     std::ofstream out(GtFile(seq));
     if (!out) throw std::runtime_error(GtFile(seq).string() + ": cannot open for writing");

@@ -157,7 +157,8 @@ std::optional<std::vector<StampedPose>> SimFolderReader::GroundTruth() const {
 }
 
 size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::string& config_yaml,
-                      const std::function<void(size_t, size_t)>& progress) {
+                      const std::function<void(size_t, size_t)>& progress,
+                      bool write_ground_truth) {
   const fs::path dir(folder);
   fs::create_directories(dir / "scans");
   {
@@ -202,7 +203,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     if (progress) progress(n, source.NumScans());
   }
   if (!imu || !scans) throw std::runtime_error(folder + ": write failed");
-  if (const auto gt = source.GroundTruth()) {
+  if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
     std::ofstream out(dir / "ground_truth.csv");
     out << "t_ns,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
     for (const auto& p : *gt) {

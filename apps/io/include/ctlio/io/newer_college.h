@@ -52,10 +52,11 @@ class NewerCollegeReader : public DataSource {
 };
 
 // Writes any data source in the Newer College layout (scan files named cloud_<sec>_<nsec>.pcd,
-// IMU counter from 0, ground truth if the source has it). `progress(done, total)` is called after
-// each scan. Returns the number of scans written.
+// IMU counter from 0, ground truth if the source has it and `write_ground_truth` is set).
+// `progress(done, total)` is called after each scan. Returns the number of scans written.
 size_t WriteNewerCollege(DataSource& source, const std::string& sequence_folder,
-                         const std::function<void(size_t, size_t)>& progress = {});
+                         const std::function<void(size_t, size_t)>& progress = {},
+                         bool write_ground_truth = true);
 
 // "<prefix>_<sec>_<nsec>.pcd" → stamp in ns; false if the name does not match.
 bool ParseNewerCollegeScanName(const std::string& file_name, int64_t* stamp_ns);

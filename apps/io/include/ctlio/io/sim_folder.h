@@ -43,10 +43,12 @@ class SimFolderReader : public DataSource {
 };
 
 // Writes any data source in the layout above. `config_yaml` (a YAML mapping, may be empty) is
-// stored under the key `config` of ctlio_sim.yaml to record how the data were made.
+// stored under the key `config` of ctlio_sim.yaml to record how the data were made. Ground truth
+// is written if the source has it and `write_ground_truth` is set.
 size_t WriteSimFolder(DataSource& source, const std::string& folder,
                       const std::string& config_yaml = "",
-                      const std::function<void(size_t, size_t)>& progress = {});
+                      const std::function<void(size_t, size_t)>& progress = {},
+                      bool write_ground_truth = true);
 
 // Reads/writes one scan file of the layout (stamp = start_ns).
 PointCloud ReadSimScan(const std::string& path, int64_t start_ns);
