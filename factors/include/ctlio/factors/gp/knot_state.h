@@ -48,16 +48,16 @@ struct LocalVariables {
     gamma[0] = xi;
     gamma[1].noalias() = J_inv * w;
     const Vec6 u2 = J_inv * k1.acceleration;
-    const Mat6 W = se3::CurlyHat(w);
-    gamma[2].noalias() = 0.5 * W * gamma[1];
-    gamma[2] += u2;
+    gamma[2] = 0.5 * CurlyHatTimes(w, gamma[1]) + u2;
     if (!with_jacobians) return;
     // ∂(J⁻¹w)/∂ξ = −J⁻¹·∂(Ju)/∂ξ|_{u=J⁻¹w} (se3_jacobian_derivative.h); u = γ2, u2 here.
-    D1.noalias() = -J_inv * LeftJacobianVectorDerivative(xi, gamma[1]);
-    D2.noalias() = -J_inv * LeftJacobianVectorDerivative(xi, u2);
-    D2.noalias() += 0.5 * W * D1;
-    E.noalias() = 0.5 * W * J_inv;
-    E -= 0.5 * se3::CurlyHat(gamma[1]);
+    const Vec6 us[2] = {gamma[1], u2};
+    Mat6 DJ[2];
+    LeftJacobianVectorDerivatives<2>(xi, us, DJ);
+    D1.noalias() = -J_inv * DJ[0];
+    D2.noalias() = -J_inv * DJ[1];
+    D2 += 0.5 * CurlyHatTimes(w, D1);
+    E = 0.5 * (CurlyHatTimes(w, J_inv) - se3::CurlyHat(gamma[1]));
     Ad21 = T21.Adjoint();
   }
 };

@@ -65,30 +65,73 @@ struct Se3JacobianCoefficients {
   }
 };
 
-// ∂(J(ξ)w)/∂ξ (6×6), J the SE(3) left Jacobian of se3::LeftJacobian.
-inline Mat6 LeftJacobianVectorDerivative(const Vec6& xi, const Vec6& w) {
+// ∂(J(ξ)w)/∂ξ (6×6) for K vectors w at the same ξ (they share the coefficients), J the SE(3)
+// left Jacobian of se3::LeftJacobian. Every matrix in the Horner recursion has the form
+// [[X, Y], [0, X]] (like ξ^⋏ itself), so it runs on 3×3 blocks:
+// A·[[X, Y], [0, X]] = [[φ^X, φ^Y + ρ^X], [0, φ^X]].
+template <int K>
+void LeftJacobianVectorDerivatives(const Vec6& xi, const Vec6 (&w)[K], Mat6 (&D)[K]) {
+  const Vec3 rho = xi.head<3>();
   const Vec3 phi = xi.tail<3>();
   const Se3JacobianCoefficients k(phi.squaredNorm());
-  const Mat6 A = se3::CurlyHat(xi);
-  Vec6 y[4];  // y_m = Aᵐw
-  y[0] = w;
-  for (int m = 1; m < 4; ++m) y[m].noalias() = A * y[m - 1];
-  const Vec6 y4 = A * y[3];
-  // z_k = Σ_{m=0}^{3−k} c_{m+k+1} y_m (c indices 0-based: c[m+k]).
-  Vec6 z[4];
-  for (int kk = 0; kk < 4; ++kk) {
-    z[kk] = k.c[kk] * y[0];
-    for (int m = 1; m + kk < 4; ++m) z[kk] += k.c[m + kk] * y[m];
+  const Mat3 P = so3::Hat(phi), R = so3::Hat(rho);
+  for (int i = 0; i < K; ++i) {
+    // y_m = Aᵐw, A·y = [φ×y_ρ + ρ×y_φ; φ×y_φ].
+    Vec6 y[5];
+    y[0] = w[i];
+    for (int m = 1; m < 5; ++m) {
+      y[m].head<3>() = phi.cross(y[m - 1].head<3>()) + rho.cross(y[m - 1].tail<3>());
+      y[m].tail<3>() = phi.cross(y[m - 1].tail<3>());
+    }
+    // z_k = Σ_{m=0}^{3−k} c_{m+k+1} y_m (c 0-based: c[m+k]).
+    Vec6 z[4];
+    for (int kk = 0; kk < 4; ++kk) {
+      z[kk] = k.c[kk] * y[0];
+      for (int m = 1; m + kk < 4; ++m) z[kk] += k.c[m + kk] * y[m];
+    }
+    Mat3 X = so3::Hat(z[3].tail<3>()), Y = so3::Hat(z[3].head<3>());
+    for (int kk = 2; kk >= 0; --kk) {
+      Mat3 Yn = so3::Hat(z[kk].head<3>());
+      Yn.noalias() += P * Y;
+      Yn.noalias() += R * X;
+      Mat3 Xn = so3::Hat(z[kk].tail<3>());
+      Xn.noalias() += P * X;
+      X = Xn;
+      Y = Yn;
+    }
+    Mat6& Di = D[i];
+    Di.topLeftCorner<3, 3>() = -X;
+    Di.topRightCorner<3, 3>() = -Y;
+    Di.bottomLeftCorner<3, 3>().setZero();
+    Di.bottomRightCorner<3, 3>() = -X;
+    const Vec6 g = 2.0 * (k.dc[0] * y[1] + k.dc[1] * y[2] + k.dc[2] * y[3] + k.dc[3] * y[4]);
+    Di.rightCols<3>().noalias() += g * phi.transpose();
   }
-  Mat6 H = se3::CurlyHat(z[3]);
-  for (int kk = 2; kk >= 0; --kk) {
-    const Mat6 AH = A * H;
-    H = se3::CurlyHat(z[kk]) + AH;
-  }
-  Mat6 D = -H;
-  const Vec6 g = 2.0 * (k.dc[0] * y[1] + k.dc[1] * y[2] + k.dc[2] * y[3] + k.dc[3] * y4);
-  D.rightCols<3>().noalias() += g * phi.transpose();
-  return D;
+}
+
+inline Mat6 LeftJacobianVectorDerivative(const Vec6& xi, const Vec6& w) {
+  const Vec6 ws[1] = {w};
+  Mat6 D[1];
+  LeftJacobianVectorDerivatives<1>(xi, ws, D);
+  return D[0];
+}
+
+// a^⋏·M for a general 6×6 M on 3×3 blocks (a^⋏ = [[φ^, ρ^], [0, φ^]]).
+inline Mat6 CurlyHatTimes(const Vec6& a, const Mat6& M) {
+  const Mat3 P = so3::Hat(a.tail<3>()), R = so3::Hat(a.head<3>());
+  Mat6 out;
+  out.topRows<3>().noalias() = P * M.topRows<3>();
+  out.topRows<3>().noalias() += R * M.bottomRows<3>();
+  out.bottomRows<3>().noalias() = P * M.bottomRows<3>();
+  return out;
+}
+
+// a^⋏·v = [φ×v_ρ + ρ×v_φ; φ×v_φ].
+inline Vec6 CurlyHatTimes(const Vec6& a, const Vec6& v) {
+  Vec6 out;
+  out.head<3>() = a.tail<3>().cross(v.head<3>()) + a.head<3>().cross(v.tail<3>());
+  out.tail<3>() = a.tail<3>().cross(v.tail<3>());
+  return out;
 }
 
 // ∂(J⁻¹(ξ)w)/∂ξ given J⁻¹(ξ) (already needed by every caller).
