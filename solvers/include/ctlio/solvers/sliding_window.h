@@ -1,0 +1,152 @@
+// SlidingWindow: the one windowed-problem component every ctlio estimator runs on (SPEC §5).
+//
+// The window owns states (parameter blocks keyed by an int64 id, e.g. a timestamp in ns, each
+// with its manifold), owns the Ceres residual blocks on them and knows which residual touches
+// which state. Solve() runs Ceres (SPARSE_NORMAL_CHOLESKY + SuiteSparse by default; every solver
+// option is exposed). Marginalize(ids) removes states by Schur complement:
+//
+//   1. every residual block touching a leaving state is linearised at the current estimate:
+//      tangent Jacobians J·PlusJacobian (the solver's own convention), with the loss function
+//      applied through the same Triggs correction Ceres uses (ceres/internal/corrector.cc):
+//      s = ‖r‖², ρ = loss(s); if s = 0 or ρ'' ≤ 0:  r ← √ρ'·r, J ← √ρ'·J;
+//      else α = 1 − √(1 + 2sρ''/ρ'), r ← √ρ'/(1 − α)·r, J ← √ρ'·(I − α·r̂r̂ᵀ)·J (r̂ = r/‖r‖),
+//      so that the marginal is the Gauss–Newton model Ceres itself minimises. A residual whose
+//      loss has ρ' ≤ 0 (fully rejected outlier) contributes nothing (Ceres would divide by 0);
+//   2. H = ΣJᵀJ, b = ΣJᵀr over [leaving states; kept states those residuals touch]
+//      (dense: windows are small);
+//   3. Schur complement onto the kept states (schur_complement.h: pseudo-inverse of the leaving
+//      block, so a singular block — an unobserved direction — never yields NaN);
+//   4. the residuals and the leaving states are removed and replaced by ONE MarginalizationPrior
+//      r = √Λ·(x ⊟ x̄) + r0 on the kept states, x̄ = their current values (first-estimate
+//      Jacobians, factors/priors/marginalization_prior.h).
+//
+// Documented edge cases (all throw std::invalid_argument / std::logic_error with file:line):
+//   - unknown or duplicate ids, an empty id list, an empty window: throw;
+//   - a leaving state that no residual touches ("disconnected"): it carries no information about
+//     the others, so it is simply removed (exact); no prior is added if nothing is connected;
+//   - a Schur complement of rank 0 (leaving states only connected among themselves): no prior;
+//   - residual evaluation failing or returning NaN/Inf at the current estimate: throws
+//     std::runtime_error and leaves the window unchanged.
+//
+// States may use nullptr (Euclidean), ctlio::PoseManifold or ctlio::RotationManifold; any other
+// manifold is rejected by AddState, because MarginalizationPrior needs the exact derivative of
+// Minus away from x̄ (see marginalization_prior.h).
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "ctlio/manifolds/se3.h"
+#include "ctlio/solvers/schur_complement.h"
+
+namespace ctlio {
+
+using StateId = std::int64_t;
+
+struct SlidingWindowOptions {
+  SlidingWindowOptions();
+  // Defaults: SPARSE_NORMAL_CHOLESKY with SUITE_SPARSE, Levenberg–Marquardt, 50 iterations,
+  // 1 thread, silent. Change freely.
+  ceres::Solver::Options solver;
+  // Eigenvalue cut-off of the Jacobi-scaled pseudo-inverse and square root
+  // (schur_complement.h).
+  double relative_eigenvalue_threshold = kDefaultRelativeEigenvalueThreshold;
+};
+
+struct MarginalizationReport {
+  std::vector<StateId> marginalized;  // ids removed
+  std::vector<StateId> kept;          // kept states the new prior is on (ascending ids)
+  int removed_residual_blocks = 0;    // residual blocks linearised and removed
+  int marginalized_dimension = 0;     // Σ tangent sizes of the removed states
+  int marginalized_rank = 0;          // rank of their information block (< dimension: singular)
+  int prior_rank = 0;                 // rows of the new prior; 0 ⇒ no prior was added
+  ceres::ResidualBlockId prior = nullptr;
+};
+
+class SlidingWindow {
+ public:
+  explicit SlidingWindow(const SlidingWindowOptions& options = SlidingWindowOptions());
+  ~SlidingWindow();
+  SlidingWindow(const SlidingWindow&) = delete;
+  SlidingWindow& operator=(const SlidingWindow&) = delete;
+
+  // ---- States -------------------------------------------------------------------------------
+  // Copies `initial` (ambient_size doubles) into window-owned storage and returns its stable
+  // address. manifold: nullptr = Euclidean, or a ctlio::PoseManifold / RotationManifold (shared).
+  double* AddState(StateId id, const double* initial, int ambient_size,
+                   std::shared_ptr<const ceres::Manifold> manifold = nullptr);
+  double* AddPoseState(StateId id, const SE3& T);                // 7 doubles, PoseManifold
+  double* AddRotationState(StateId id, const Mat3& C);           // 4 doubles, RotationManifold
+  double* AddVectorState(StateId id, const Eigen::VectorXd& v);  // Euclidean
+  // Removes a state and every residual block on it WITHOUT keeping its information.
+  void RemoveState(StateId id);
+
+  bool HasState(StateId id) const { return states_.count(id) != 0; }
+  double* State(StateId id);
+  const double* State(StateId id) const;
+  SE3 Pose(StateId id) const;                // for a PoseManifold state
+  Eigen::VectorXd Vector(StateId id) const;  // the ambient values of any state
+  int AmbientSize(StateId id) const;
+  int TangentSize(StateId id) const;
+  const ceres::Manifold* Manifold(StateId id) const;  // nullptr for Euclidean
+  std::vector<StateId> StateIds() const;              // ascending
+  int num_states() const { return static_cast<int>(states_.size()); }
+  // Constant states are not optimised; Covariance() conditions on them (treats them as known).
+  void SetStateConstant(StateId id, bool constant);
+  bool IsStateConstant(StateId id) const;
+
+  // ---- Residual blocks ----------------------------------------------------------------------
+  // Takes ownership of cost and loss (like ceres::Problem; a loss may be shared). The cost's
+  // parameter blocks are the listed states in order.
+  ceres::ResidualBlockId AddResidualBlock(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                          const std::vector<StateId>& states);
+  void RemoveResidualBlock(ceres::ResidualBlockId id);
+  int num_residual_blocks() const { return static_cast<int>(residuals_.size()); }
+  std::vector<ceres::ResidualBlockId> ResidualBlocksOf(StateId id) const;
+  const std::vector<StateId>& StatesOf(ceres::ResidualBlockId id) const;
+
+  // ---- Estimation ---------------------------------------------------------------------------
+  // Throws std::logic_error on an empty window.
+  ceres::Solver::Summary Solve();
+  MarginalizationReport Marginalize(const std::vector<StateId>& ids);
+
+  // Joint marginal covariance (tangent spaces, in the order of `ids`) of the listed states under
+  // the Gauss–Newton model of the whole window at the current estimate: the pseudo-inverse of the
+  // dense information of all non-constant states (loss functions applied as in Marginalize).
+  Eigen::MatrixXd Covariance(const std::vector<StateId>& ids) const;
+
+  // Linearised information (H, b = Jᵀr) of the given residual blocks over the given states
+  // (tangent spaces, in that order; residuals may only touch listed or constant states).
+  void Linearize(const std::vector<ceres::ResidualBlockId>& residuals,
+                 const std::vector<StateId>& ordering, Eigen::MatrixXd* H,
+                 Eigen::VectorXd* b) const;
+
+  SlidingWindowOptions& options() { return options_; }
+  // The underlying problem, for what the window does not wrap (e.g. parameter bounds). Adding or
+  // removing blocks through it bypasses the window's bookkeeping: do not.
+  ceres::Problem& problem() { return *problem_; }
+
+ private:
+  struct StateBlock {
+    std::unique_ptr<double[]> values;
+    int ambient_size = 0;
+    int tangent_size = 0;
+    std::shared_ptr<const ceres::Manifold> manifold;
+    std::set<ceres::ResidualBlockId> residuals;
+  };
+  const StateBlock& Get(StateId id, int line) const;
+  StateBlock& Get(StateId id, int line);
+
+  SlidingWindowOptions options_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::map<StateId, StateBlock> states_;
+  std::map<ceres::ResidualBlockId, std::vector<StateId>> residuals_;
+};
+
+}  // namespace ctlio

@@ -1,0 +1,427 @@
+#include "ctlio/solvers/sliding_window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+#include "ctlio/factors/priors/marginalization_prior.h"
+#include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/manifolds/rotation_manifold.h"
+
+namespace ctlio {
+namespace {
+
+template <typename Exception = std::invalid_argument>
+[[noreturn]] void Throw(int line, const std::string& what) {
+  std::ostringstream msg;
+  msg << __FILE__ << ":" << line << ": SlidingWindow: " << what;
+  throw Exception(msg.str());
+}
+
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Ceres' Corrector (Triggs et al., "Bundle adjustment — a modern synthesis", §4.3), applied in
+// place to one residual block's residual r and tangent Jacobian J. See sliding_window.h.
+void ApplyLoss(const ceres::LossFunction* loss, Eigen::VectorXd* r, RowMajorMatrix* J) {
+  if (loss == nullptr) return;
+  const double s = r->squaredNorm();
+  double rho[3];
+  loss->Evaluate(s, rho);
+  if (!(rho[1] > 0.0) || !std::isfinite(rho[1])) {  // fully rejected: contributes nothing
+    r->setZero();
+    J->setZero();
+    return;
+  }
+  const double sqrt_rho1 = std::sqrt(rho[1]);
+  if (s == 0.0 || rho[2] <= 0.0) {
+    *r *= sqrt_rho1;
+    *J *= sqrt_rho1;
+    return;
+  }
+  const double D = 1.0 + 2.0 * s * rho[2] / rho[1];
+  const double alpha = 1.0 - std::sqrt(D);
+  // Jacobian first: it uses the uncorrected residual.
+  const Eigen::RowVectorXd rTJ = r->transpose() * (*J);
+  *J = sqrt_rho1 * (*J - (alpha / s) * (*r) * rTJ);
+  *r *= sqrt_rho1 / (1.0 - alpha);
+}
+
+std::string IdList(const std::vector<StateId>& ids) {
+  std::ostringstream s;
+  for (size_t i = 0; i < ids.size(); ++i) s << (i ? ", " : "") << ids[i];
+  return s.str();
+}
+
+}  // namespace
+
+SlidingWindowOptions::SlidingWindowOptions() {
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver.max_num_iterations = 50;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  solver.minimizer_progress_to_stdout = false;
+}
+
+SlidingWindow::SlidingWindow(const SlidingWindowOptions& options) : options_(options) {
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // states hold shared_ptrs
+  problem_options.enable_fast_removal = true;
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+}
+
+// The problem (which references the manifolds) goes before the states that own them.
+SlidingWindow::~SlidingWindow() { problem_.reset(); }
+
+const SlidingWindow::StateBlock& SlidingWindow::Get(StateId id, int line) const {
+  const auto it = states_.find(id);
+  if (it == states_.end()) Throw(line, "unknown state id " + std::to_string(id));
+  return it->second;
+}
+
+SlidingWindow::StateBlock& SlidingWindow::Get(StateId id, int line) {
+  const auto it = states_.find(id);
+  if (it == states_.end()) Throw(line, "unknown state id " + std::to_string(id));
+  return it->second;
+}
+
+double* SlidingWindow::AddState(StateId id, const double* initial, int ambient_size,
+                                std::shared_ptr<const ceres::Manifold> manifold) {
+  if (states_.count(id) != 0) Throw(__LINE__, "state id " + std::to_string(id) + " exists");
+  if (initial == nullptr || ambient_size <= 0) {
+    Throw(__LINE__, "state " + std::to_string(id) + " needs initial values and a size > 0");
+  }
+  MarginalizationPrior::TypeOf(manifold.get());  // throws for manifolds the prior cannot handle
+  if (manifold != nullptr && manifold->AmbientSize() != ambient_size) {
+    Throw(__LINE__, "state " + std::to_string(id) + ": size " + std::to_string(ambient_size) +
+                        " does not match its manifold's ambient size " +
+                        std::to_string(manifold->AmbientSize()));
+  }
+  for (int i = 0; i < ambient_size; ++i) {
+    if (!std::isfinite(initial[i])) {
+      Throw(__LINE__, "state " + std::to_string(id) + " has NaN/Inf initial values");
+    }
+  }
+  StateBlock block;
+  block.values.reset(new double[ambient_size]);
+  std::copy(initial, initial + ambient_size, block.values.get());
+  block.ambient_size = ambient_size;
+  block.tangent_size = manifold == nullptr ? ambient_size : manifold->TangentSize();
+  block.manifold = std::move(manifold);
+  double* values = block.values.get();
+  problem_->AddParameterBlock(values, ambient_size,
+                              const_cast<ceres::Manifold*>(block.manifold.get()));
+  states_.emplace(id, std::move(block));
+  return values;
+}
+
+double* SlidingWindow::AddPoseState(StateId id, const SE3& T) {
+  static const auto manifold = std::make_shared<const PoseManifold>();
+  double x[7];
+  PoseManifold::Store(T, x);
+  return AddState(id, x, 7, manifold);
+}
+
+double* SlidingWindow::AddRotationState(StateId id, const Mat3& C) {
+  static const auto manifold = std::make_shared<const RotationManifold>();
+  double q[4];
+  RotationManifold::Store(C, q);
+  return AddState(id, q, 4, manifold);
+}
+
+double* SlidingWindow::AddVectorState(StateId id, const Eigen::VectorXd& v) {
+  return AddState(id, v.data(), static_cast<int>(v.size()), nullptr);
+}
+
+void SlidingWindow::RemoveState(StateId id) {
+  StateBlock& block = Get(id, __LINE__);
+  const std::set<ceres::ResidualBlockId> residuals = block.residuals;
+  for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
+  problem_->RemoveParameterBlock(block.values.get());
+  states_.erase(id);
+}
+
+double* SlidingWindow::State(StateId id) { return Get(id, __LINE__).values.get(); }
+const double* SlidingWindow::State(StateId id) const { return Get(id, __LINE__).values.get(); }
+
+SE3 SlidingWindow::Pose(StateId id) const {
+  const StateBlock& block = Get(id, __LINE__);
+  if (dynamic_cast<const PoseManifold*>(block.manifold.get()) == nullptr) {
+    Throw(__LINE__, "state " + std::to_string(id) + " is not a pose");
+  }
+  return PoseManifold::Pose(block.values.get());
+}
+
+Eigen::VectorXd SlidingWindow::Vector(StateId id) const {
+  const StateBlock& block = Get(id, __LINE__);
+  return Eigen::Map<const Eigen::VectorXd>(block.values.get(), block.ambient_size);
+}
+
+int SlidingWindow::AmbientSize(StateId id) const { return Get(id, __LINE__).ambient_size; }
+int SlidingWindow::TangentSize(StateId id) const { return Get(id, __LINE__).tangent_size; }
+const ceres::Manifold* SlidingWindow::Manifold(StateId id) const {
+  return Get(id, __LINE__).manifold.get();
+}
+
+std::vector<StateId> SlidingWindow::StateIds() const {
+  std::vector<StateId> ids;
+  ids.reserve(states_.size());
+  for (const auto& [id, block] : states_) ids.push_back(id);
+  return ids;
+}
+
+void SlidingWindow::SetStateConstant(StateId id, bool constant) {
+  double* values = Get(id, __LINE__).values.get();
+  if (constant) {
+    problem_->SetParameterBlockConstant(values);
+  } else {
+    problem_->SetParameterBlockVariable(values);
+  }
+}
+
+bool SlidingWindow::IsStateConstant(StateId id) const {
+  return problem_->IsParameterBlockConstant(Get(id, __LINE__).values.get());
+}
+
+ceres::ResidualBlockId SlidingWindow::AddResidualBlock(ceres::CostFunction* cost,
+                                                       ceres::LossFunction* loss,
+                                                       const std::vector<StateId>& states) {
+  if (cost == nullptr) Throw(__LINE__, "null cost function");
+  const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
+  if (sizes.size() != states.size()) {
+    Throw(__LINE__, "cost function has " + std::to_string(sizes.size()) + " parameter blocks but " +
+                        std::to_string(states.size()) + " states were given (" + IdList(states) +
+                        ")");
+  }
+  std::vector<double*> blocks;
+  for (size_t i = 0; i < states.size(); ++i) {
+    const StateBlock& block = Get(states[i], __LINE__);
+    if (block.ambient_size != sizes[i]) {
+      Throw(__LINE__, "parameter block " + std::to_string(i) + " of the cost function has size " +
+                          std::to_string(sizes[i]) + " but state " + std::to_string(states[i]) +
+                          " has " + std::to_string(block.ambient_size));
+    }
+    if (std::count(states.begin(), states.end(), states[i]) > 1) {
+      Throw(__LINE__, "state " + std::to_string(states[i]) + " listed twice");
+    }
+    blocks.push_back(block.values.get());
+  }
+  const ceres::ResidualBlockId id = problem_->AddResidualBlock(cost, loss, blocks);
+  residuals_.emplace(id, states);
+  for (StateId s : states) states_.at(s).residuals.insert(id);
+  return id;
+}
+
+void SlidingWindow::RemoveResidualBlock(ceres::ResidualBlockId id) {
+  const auto it = residuals_.find(id);
+  if (it == residuals_.end()) Throw(__LINE__, "unknown residual block");
+  for (StateId s : it->second) states_.at(s).residuals.erase(id);
+  residuals_.erase(it);
+  problem_->RemoveResidualBlock(id);
+}
+
+std::vector<ceres::ResidualBlockId> SlidingWindow::ResidualBlocksOf(StateId id) const {
+  const StateBlock& block = Get(id, __LINE__);
+  return {block.residuals.begin(), block.residuals.end()};
+}
+
+const std::vector<StateId>& SlidingWindow::StatesOf(ceres::ResidualBlockId id) const {
+  const auto it = residuals_.find(id);
+  if (it == residuals_.end()) Throw(__LINE__, "unknown residual block");
+  return it->second;
+}
+
+ceres::Solver::Summary SlidingWindow::Solve() {
+  if (states_.empty()) Throw<std::logic_error>(__LINE__, "Solve() on an empty window");
+  ceres::Solver::Summary summary;
+  ceres::Solve(options_.solver, problem_.get(), &summary);
+  return summary;
+}
+
+void SlidingWindow::Linearize(const std::vector<ceres::ResidualBlockId>& residuals,
+                              const std::vector<StateId>& ordering, Eigen::MatrixXd* H,
+                              Eigen::VectorXd* b) const {
+  std::unordered_map<StateId, int> offset;
+  int n = 0;
+  for (StateId id : ordering) {
+    if (!offset.emplace(id, n).second) Throw(__LINE__, "state " + std::to_string(id) + " twice");
+    n += Get(id, __LINE__).tangent_size;
+  }
+  H->setZero(n, n);
+  b->setZero(n);
+  for (ceres::ResidualBlockId rid : residuals) {
+    const std::vector<StateId>& states = StatesOf(rid);
+    const ceres::CostFunction* cost = problem_->GetCostFunctionForResidualBlock(rid);
+    const ceres::LossFunction* loss = problem_->GetLossFunctionForResidualBlock(rid);
+    const int m = cost->num_residuals();
+    std::vector<const double*> parameters;
+    std::vector<RowMajorMatrix> ambient(states.size());
+    std::vector<double*> jacobians;
+    for (size_t i = 0; i < states.size(); ++i) {
+      const StateBlock& block = Get(states[i], __LINE__);
+      parameters.push_back(block.values.get());
+      ambient[i].setZero(m, block.ambient_size);
+      jacobians.push_back(ambient[i].data());
+    }
+    Eigen::VectorXd r(m);
+    if (!cost->Evaluate(parameters.data(), r.data(), jacobians.data())) {
+      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(states) +
+                                              ") failed to evaluate at the current estimate");
+    }
+    // Tangent Jacobian of the whole block row: [J₁·P₁, J₂·P₂, …] with P = PlusJacobian.
+    int width = 0;
+    for (StateId s : states) width += Get(s, __LINE__).tangent_size;
+    RowMajorMatrix J(m, width);
+    int c = 0;
+    for (size_t i = 0; i < states.size(); ++i) {
+      const StateBlock& block = Get(states[i], __LINE__);
+      if (block.manifold == nullptr) {
+        J.middleCols(c, block.tangent_size) = ambient[i];
+      } else {
+        RowMajorMatrix plus(block.ambient_size, block.tangent_size);
+        block.manifold->PlusJacobian(block.values.get(), plus.data());
+        J.middleCols(c, block.tangent_size) = ambient[i] * plus;
+      }
+      c += block.tangent_size;
+    }
+    if (!r.allFinite() || !J.allFinite()) {
+      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(states) +
+                                              ") is NaN/Inf at the current estimate");
+    }
+    ApplyLoss(loss, &r, &J);
+    // Scatter JᵀJ and Jᵀr into H and b: (column in J, row in H, size) of each ordered state.
+    struct Slot {
+      int column, row, size;
+    };
+    std::vector<Slot> slots;
+    c = 0;
+    for (StateId s : states) {
+      const int size = Get(s, __LINE__).tangent_size;
+      const auto it = offset.find(s);
+      if (it != offset.end()) {
+        slots.push_back({c, it->second, size});
+      } else if (!IsStateConstant(s)) {
+        Throw<std::logic_error>(__LINE__, "residual touches state " + std::to_string(s) +
+                                              " which is neither in the ordering nor constant");
+      }
+      c += size;
+    }
+    for (const Slot& i : slots) {
+      const auto Ji = J.middleCols(i.column, i.size);
+      b->segment(i.row, i.size).noalias() += Ji.transpose() * r;
+      for (const Slot& j : slots) {
+        H->block(i.row, j.row, i.size, j.size).noalias() +=
+            Ji.transpose() * J.middleCols(j.column, j.size);
+      }
+    }
+  }
+}
+
+MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids) {
+  if (states_.empty()) Throw<std::logic_error>(__LINE__, "Marginalize() on an empty window");
+  if (ids.empty()) Throw(__LINE__, "Marginalize() needs at least one state id");
+  std::set<StateId> leaving;
+  for (StateId id : ids) {
+    if (states_.count(id) == 0) {
+      Throw(__LINE__, "cannot marginalise unknown state id " + std::to_string(id));
+    }
+    if (!leaving.insert(id).second) Throw(__LINE__, "state id " + std::to_string(id) + " twice");
+  }
+
+  MarginalizationReport report;
+  report.marginalized.assign(leaving.begin(), leaving.end());
+  std::set<ceres::ResidualBlockId> residual_set;
+  std::set<StateId> kept;
+  for (StateId id : leaving) {
+    const StateBlock& block = states_.at(id);
+    report.marginalized_dimension += block.tangent_size;
+    for (ceres::ResidualBlockId r : block.residuals) {
+      residual_set.insert(r);
+      for (StateId s : residuals_.at(r)) {
+        if (leaving.count(s) == 0) kept.insert(s);
+      }
+    }
+  }
+  report.kept.assign(kept.begin(), kept.end());
+  report.removed_residual_blocks = static_cast<int>(residual_set.size());
+
+  // Everything that can throw happens before the window changes.
+  Eigen::MatrixXd sqrt_information;
+  Eigen::VectorXd r0;
+  if (!residual_set.empty()) {
+    std::vector<StateId> ordering(report.marginalized);
+    ordering.insert(ordering.end(), report.kept.begin(), report.kept.end());
+    Eigen::MatrixXd H;
+    Eigen::VectorXd b;
+    const std::vector<ceres::ResidualBlockId> residuals(residual_set.begin(), residual_set.end());
+    Linearize(residuals, ordering, &H, &b);
+    const SchurComplementResult schur = SchurComplementLeading(
+        H, b, report.marginalized_dimension, options_.relative_eigenvalue_threshold);
+    report.marginalized_rank = schur.marginalized_rank;
+    if (!kept.empty()) {
+      report.prior_rank = InformationSquareRoot(schur.information, schur.vector, &sqrt_information,
+                                                &r0, options_.relative_eigenvalue_threshold);
+    }
+  }
+  std::unique_ptr<MarginalizationPrior> prior;
+  if (report.prior_rank > 0) {
+    std::vector<const ceres::Manifold*> manifolds;
+    std::vector<int> sizes;
+    std::vector<const double*> points;
+    for (StateId id : report.kept) {
+      const StateBlock& block = states_.at(id);
+      manifolds.push_back(block.manifold.get());
+      sizes.push_back(block.ambient_size);
+      points.push_back(block.values.get());
+    }
+    prior = std::make_unique<MarginalizationPrior>(manifolds, sizes, points, sqrt_information, r0);
+  }
+
+  for (ceres::ResidualBlockId r : residual_set) RemoveResidualBlock(r);
+  for (StateId id : leaving) {
+    problem_->RemoveParameterBlock(states_.at(id).values.get());
+    states_.erase(id);
+  }
+  if (prior != nullptr) report.prior = AddResidualBlock(prior.release(), nullptr, report.kept);
+  return report;
+}
+
+Eigen::MatrixXd SlidingWindow::Covariance(const std::vector<StateId>& ids) const {
+  if (ids.empty()) Throw(__LINE__, "Covariance() needs at least one state id");
+  std::vector<StateId> ordering;
+  std::unordered_map<StateId, int> offset;
+  int n = 0;
+  for (const auto& [id, block] : states_) {
+    if (problem_->IsParameterBlockConstant(block.values.get())) continue;
+    ordering.push_back(id);
+    offset[id] = n;
+    n += block.tangent_size;
+  }
+  std::vector<int> index;
+  for (StateId id : ids) {
+    const StateBlock& block = Get(id, __LINE__);
+    const auto it = offset.find(id);
+    if (it == offset.end()) Throw(__LINE__, "state " + std::to_string(id) + " is constant");
+    for (int k = 0; k < block.tangent_size; ++k) index.push_back(it->second + k);
+  }
+  std::vector<ceres::ResidualBlockId> all;
+  for (const auto& [rid, states] : residuals_) all.push_back(rid);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  Linearize(all, ordering, &H, &b);
+  const Eigen::MatrixXd P = PseudoInverse(H, options_.relative_eigenvalue_threshold);
+  const int k = static_cast<int>(index.size());
+  Eigen::MatrixXd out(k, k);
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) out(i, j) = P(index[i], index[j]);
+  return out;
+}
+
+}  // namespace ctlio
