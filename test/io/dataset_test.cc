@@ -164,6 +164,9 @@ TEST(BadInput, MalformedCsvLinesNameFileAndLine) {
   ExpectError([&] { NewerCollegeReader r(d.string()); }, {"data.csv:5", "expected 9", "found 5"});
   ReplaceLine(imu, 5, "3,1583836591,197590000,0.1,0.2,0.3,,2,3");
   ExpectError([&] { NewerCollegeReader r(d.string()); }, {"data.csv:5", "empty field"});
+  // A trailing comma and CRLF are tolerated (documented in text_table.h).
+  ReplaceLine(imu, 5, "3,1583836591,197590000,0.1,0.2,0.3,1,2,3,\r");
+  EXPECT_NO_THROW(NewerCollegeReader r(d.string()));
   const fs::path e = NewerCollegeFixture("malformed_gt");
   ReplaceLine(e / "ground_truth/registered_poses.csv", 3, "1583836599,1,0,0,0,0,0,0,3");
   ExpectError([&] { NewerCollegeReader r(e.string()); }, {"registered_poses.csv:3", "quaternion"});

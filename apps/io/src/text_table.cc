@@ -35,7 +35,11 @@ std::vector<TableRow> ReadTable(const std::string& path, bool skip_header) {
   std::string line;
   bool first = true;
   for (int n = 1; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    // Tolerated: CRLF line ends, trailing blanks and one trailing comma (common in exports).
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
+      line.pop_back();
+    }
+    if (!line.empty() && line.back() == ',') line.pop_back();
     TableRow row;
     row.line = n;
     std::string cur;

@@ -12,7 +12,8 @@ struct TableRow {
   std::vector<std::string> fields;  // split on ',' and/or whitespace
 };
 
-// Reads every non-empty line that does not start with '#'. If `skip_header` is true and the first
+// Reads every non-empty line that does not start with '#'. CRLF line ends, trailing blanks and one
+// trailing comma are tolerated; an empty field inside a line is reported by ExpectFields. If `skip_header` is true and the first
 // such line contains a field that is not a number, it is skipped. Throws "<path>: file not found".
 std::vector<TableRow> ReadTable(const std::string& path, bool skip_header);
 
