@@ -153,6 +153,7 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.max_plane_distance, 1.0);
   EXPECT_EQ(o.max_iterations, 10);
   EXPECT_EQ(o.solver_iterations, d.solver_iterations);
+  EXPECT_EQ(o.point_noise_sigma, 0.03);
   EXPECT_EQ(o.loss, d.loss);
   EXPECT_EQ(o.loss_scale, d.loss_scale);
   EXPECT_EQ(o.convergence_translation, d.convergence_translation);
@@ -174,6 +175,7 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_EQ(ErrorOf("voxel_size: 0.3\nmin_neighbours: ten\n"),
             "test.yaml:2: bad value for 'min_neighbours'");
   EXPECT_NE(ErrorOf("min_neighbours: 30\n").find("max_neighbours"), std::string::npos);
+  EXPECT_NE(ErrorOf("point_noise_sigma: 0\n").find("point_noise_sigma"), std::string::npos);
   EXPECT_NE(ErrorOf("loss: tukey\n").find("loss"), std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);
   EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("voxel_size: 0.3\n")).voxel_size, 0.3);

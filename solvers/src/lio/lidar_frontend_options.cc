@@ -43,6 +43,7 @@ void LidarFrontendOptions::Validate() const {
   require(max_iterations >= 1 && solver_iterations >= 1, "iteration counts must be >= 1");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
+  require(point_noise_sigma > 0.0, "point_noise_sigma must be positive");
   require(loss_scale > 0.0, "loss_scale must be positive");
   require(convergence_translation >= 0.0 && convergence_rotation >= 0.0,
           "convergence thresholds must be >= 0");
@@ -72,6 +73,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
       {"max_plane_distance", Setter(&o.max_plane_distance)},
       {"max_iterations", Setter(&o.max_iterations)},
       {"solver_iterations", Setter(&o.solver_iterations)},
+      {"point_noise_sigma", Setter(&o.point_noise_sigma)},
       {"loss", Setter(&o.loss)},
       {"loss_scale", Setter(&o.loss_scale)},
       {"convergence_translation", Setter(&o.convergence_translation)},

@@ -41,8 +41,12 @@ struct LidarFrontendOptions {
   // Registration: re-association rounds, solver iterations per round, robust loss.
   int max_iterations = 10;
   int solver_iterations = 5;
-  std::string loss = "cauchy";  // "cauchy", "huber" or "none"
-  double loss_scale = 0.2;      // metres (applied to the weighted residual)
+  // Standard deviation of a point-to-plane residual (range noise of an OS1-64 class lidar plus
+  // plane-fit noise): residuals enter the problem as w/σ · nᵀ(p_ref − T_mr q), which sets their
+  // weight against the GP prior (whitened by Q⁻¹, SPEC §2).
+  double point_noise_sigma = 0.03;  // m
+  std::string loss = "cauchy";      // "cauchy", "huber" or "none"
+  double loss_scale = 0.1;  // metres, on the planarity-weighted residual w·nᵀ(p_ref − T_mr q)
   // Stop re-associating when the knots' poses move less than this between rounds.
   double convergence_translation = 1e-3;  // m
   double convergence_rotation = 1e-4;     // rad
