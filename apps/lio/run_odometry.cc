@@ -93,7 +93,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
     for (const io::ImuSample& s : frame.imu) {
-      lio::ImuSample x;
+      lio::ImuSample x;  // = imu::ImuSample
       x.t_ns = s.t_ns;
       x.gyro = s.gyro;
       x.accel = s.accel;
@@ -148,14 +148,15 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write the scan log");
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
-       "ms x y z message\n";
+       "ms ms_preprocess ms_associate ms_solve ms_map x y z message\n";
   f << std::setprecision(12);
   for (const lio::ScanResult& r : run.scans) {
     const Vec3 p = r.T_mr.translation();
     f << 1e-9 * double(r.t_ns) << ' ' << lio::ScanStatusName(r.status) << ' ' << r.keypoints << ' '
       << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds << ' ' << r.solver_iterations
-      << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << p.x() << ' ' << p.y() << ' '
-      << p.z() << ' ' << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+      << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << r.ms_preprocess << ' '
+      << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << p.x() << ' ' << p.y()
+      << ' ' << p.z() << ' ' << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
 }
 

@@ -4,6 +4,7 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -141,7 +142,12 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
   PlaneAssociator associator(frontend_.map(), config_.frontend);
   SE3 last_pose = PoseManifold::Pose(s.pose);
   bool degenerate = false;
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
   for (int round = 0; round < config_.frontend.max_iterations; ++round) {
+    auto t0 = Clock::now();
     for (ceres::ResidualBlockId id : lidar_blocks) problem_.RemoveResidualBlock(id);
     lidar_blocks.clear();
     // Deskew with the current estimate: every point moved into the body frame at the scan end
@@ -163,8 +169,11 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
       lidar_blocks.clear();
       degenerate = true;
     }
+    result->ms_associate += ms_since(t0);
+    t0 = Clock::now();
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem_, &summary);
+    result->ms_solve += ms_since(t0);
     result->rounds = round + 1;
     result->solver_iterations += static_cast<int>(summary.iterations.size());
     result->final_cost = summary.final_cost;
@@ -178,6 +187,7 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
   }
 
   // Map update with every preprocessed point, deskewed by the final estimate.
+  const auto t_map = Clock::now();
   const DeskewTable table = Integrate(prev, s.t);
   const SE3 T_end_inv = table.T_wb.back().Inverse();
   const SE3 T_wb = PoseManifold::Pose(s.pose);
@@ -204,6 +214,7 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
                       " plane associations (need " + std::to_string(config_.min_associations) +
                       "): lidar term dropped for this scan";
   }
+  result->ms_map = ms_since(t_map);
   Fill(s, ScanStatus::kOk, result);
   states_.push_back(std::move(owned));
   Slide();

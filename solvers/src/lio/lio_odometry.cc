@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/factors/imu/gravity_initialization.h"
 #include "ctlio/solvers/lio/imu_input_lio.h"
 #include "ctlio/solvers/lio/singer_lio.h"
 
@@ -94,37 +95,31 @@ void LioOdometry::TrimImu(double t) {
   while (imu_.size() > 1 && Seconds(imu_[1].t_ns) <= t) imu_.pop_front();
 }
 
-// SPEC §3: at rest the accelerometer measures the specific force C_ri·(0 − g_i) = g·C_ri·e_z.
-// The map frame is the robot frame at the start, so C_mi = C_ri(0) is the smallest rotation
-// taking e_z onto the mean accelerometer direction (yaw is unobservable and set to zero).
+// SPEC §3: gravity initialisation from the accelerometer while still (imu::InitializeGravity,
+// which also judges stillness). The map frame is the robot frame at the start, so its C_mi is
+// the map's. Uses the last gravity_init_duration seconds of IMU up to the first scan end.
 bool LioOdometry::InitialiseGravity(double t_end, std::string* message) {
-  const double t_begin = std::min(0.0, t_end - config_.gravity_init_duration);
-  std::vector<Vec3> a;
-  for (const ImuSample& s : imu_) {
-    const double t = Seconds(s.t_ns);
-    if (t >= t_begin - config_.gravity_init_duration && t <= t_end) a.push_back(s.accel);
-  }
-  if (a.size() < 5) {
-    *message = "gravity initialisation: only " + std::to_string(a.size()) +
-               " IMU samples before the first scan end (need >= 5)";
+  std::vector<ImuSample> samples(imu_.begin(), imu_.end());
+  if (samples.empty()) {
+    *message = "gravity initialisation: no IMU samples before the first scan end";
     return false;
   }
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& x : a) mean += x;
-  mean /= static_cast<double>(a.size());
-  double var = 0.0;
-  for (const Vec3& x : a) var += (x - mean).squaredNorm();
-  const double std_dev = std::sqrt(var / static_cast<double>(a.size()));
-  if (std_dev > config_.gravity_init_max_std ||
-      std::abs(mean.norm() - config_.gravity) > 3.0 * config_.gravity_init_max_std + 0.5) {
-    std::ostringstream s;
-    s << "gravity initialisation: platform not still (accelerometer spread " << std_dev
-      << " m/s^2, |mean| " << mean.norm() << " m/s^2, limit " << config_.gravity_init_max_std
-      << " m/s^2 around g = " << config_.gravity << ")";
-    *message = s.str();
+  const int64_t end_ns = origin_ns_ + static_cast<int64_t>(std::llround(t_end * 1e9));
+  const int64_t t0_ns =
+      std::max(samples.front().t_ns,
+               end_ns - static_cast<int64_t>(std::llround(config_.gravity_init_duration * 1e9)));
+  imu::GravityInitializationOptions options;
+  options.gravity = config_.gravity;
+  options.max_block_accel_deviation = config_.gravity_init_max_std;
+  options.min_samples = 10;
+  try {
+    const imu::GravityInitialization g =
+        imu::InitializeGravity(samples, t0_ns, end_ns - t0_ns + 1, options);
+    C_mi_ = g.C_mi;
+  } catch (const std::exception& e) {
+    *message = std::string("gravity initialisation failed: ") + e.what();
     return false;
   }
-  C_mi_ = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), mean.normalized()).toRotationMatrix();
   return true;
 }
 
@@ -167,8 +162,14 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   }
   prepared.points = frontend_.Preprocess(raw);
   prepared.keypoints = frontend_.Keypoints(prepared.points);
+  // Time order groups the points of one firing, whose interpolated pose the pipelines share.
+  const auto by_time = [](const TimedPoint& a, const TimedPoint& b) { return a.time < b.time; };
+  std::stable_sort(prepared.points.begin(), prepared.points.end(), by_time);
+  std::stable_sort(prepared.keypoints.begin(), prepared.keypoints.end(), by_time);
 
   ScanResult result;
+  result.ms_preprocess =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
   try {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/factors/imu/imu_data.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/manifolds/types.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
@@ -66,7 +67,9 @@ struct OdometryConfig {
 
   // --- Initialisation and robustness.
   double gravity_init_duration = 0.2;  // s of accelerometer averaged while still at start
-  double gravity_init_max_std = 0.5;   // m/s²: "still enough" threshold on the accel spread
+  // "Still enough" (imu::InitializeGravity): largest deviation of a 0.1 s block mean of the
+  // accelerometer from the overall mean.
+  double gravity_init_max_std = 0.4;  // m/s²
   // A scan whose keypoints produce fewer than this many plane associations is degenerate: the
   // lidar term is dropped for it (the prior + IMU carry the state) and the scan is flagged.
   int min_associations = 50;
@@ -92,11 +95,8 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
 OdometryConfig LoadOdometryConfig(const std::string& path);
 
 // --- Pipeline input (what a dataset reader or the simulator hands over, converted by the app).
-struct ImuSample {
-  int64_t t_ns = 0;
-  Vec3 gyro = Vec3::Zero();   // rad/s, IMU frame
-  Vec3 accel = Vec3::Zero();  // m/s² (specific force), IMU frame
-};
+// IMU samples are the IMU library's (robot = IMU frame).
+using ImuSample = imu::ImuSample;
 
 struct LidarScan {
   int64_t begin_ns = 0;           // first firing
@@ -122,7 +122,11 @@ struct ScanResult {
   int rounds = 0;  // re-association rounds
   int solver_iterations = 0;
   double final_cost = 0.0;
-  double milliseconds = 0.0;  // wall time of this scan
+  double milliseconds = 0.0;   // wall time of this scan, split into:
+  double ms_preprocess = 0.0;  // range gate, subsampling, keypoints
+  double ms_associate = 0.0;   // interpolation + kNN + plane fits, all rounds
+  double ms_solve = 0.0;       // Ceres, all rounds
+  double ms_map = 0.0;         // deskew + map insertion
 };
 
 }  // namespace ctlio::lio
