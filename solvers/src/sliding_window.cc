@@ -245,81 +245,132 @@ ceres::Solver::Summary SlidingWindow::Solve() {
   return summary;
 }
 
+// Residual blocks on the same tuple of states (e.g. the 1,000 lidar residuals of one knot
+// interval) are accumulated into one dense local information matrix by symmetric rank updates and
+// scattered into H once per tuple; PlusJacobians are computed once per state.
 void SlidingWindow::Linearize(const std::vector<ceres::ResidualBlockId>& residuals,
                               const std::vector<StateId>& ordering, Eigen::MatrixXd* H,
                               Eigen::VectorXd* b) const {
-  std::unordered_map<StateId, int> offset;
+  struct StateInfo {
+    const StateBlock* block = nullptr;
+    int offset = -1;  // row in H, -1 if not in the ordering (then it must be constant)
+    RowMajorMatrix plus;
+    bool plus_ready = false;
+  };
+  std::unordered_map<StateId, StateInfo> info;
   int n = 0;
   for (StateId id : ordering) {
-    if (!offset.emplace(id, n).second) Throw(__LINE__, "state " + std::to_string(id) + " twice");
-    n += Get(id, __LINE__).tangent_size;
+    StateInfo& s = info[id];
+    if (s.block != nullptr) Throw(__LINE__, "state " + std::to_string(id) + " twice");
+    s.block = &Get(id, __LINE__);
+    s.offset = n;
+    n += s.block->tangent_size;
   }
-  H->setZero(n, n);
-  b->setZero(n);
+  struct Group {
+    std::vector<StateInfo*> states;
+    Eigen::MatrixXd H;  // lower triangle accumulated
+    Eigen::VectorXd b;
+  };
+  std::map<std::vector<StateId>, Group> groups;
+
+  std::vector<const double*> parameters;
+  std::vector<double*> jacobians;
+  std::vector<RowMajorMatrix> ambient;
+  Eigen::VectorXd r;
+  RowMajorMatrix J;
   for (ceres::ResidualBlockId rid : residuals) {
-    const std::vector<StateId>& states = StatesOf(rid);
-    const ceres::CostFunction* cost = problem_->GetCostFunctionForResidualBlock(rid);
-    const ceres::LossFunction* loss = problem_->GetLossFunctionForResidualBlock(rid);
-    const int m = cost->num_residuals();
-    std::vector<const double*> parameters;
-    std::vector<RowMajorMatrix> ambient(states.size());
-    std::vector<double*> jacobians;
-    for (size_t i = 0; i < states.size(); ++i) {
-      const StateBlock& block = Get(states[i], __LINE__);
-      parameters.push_back(block.values.get());
-      ambient[i].setZero(m, block.ambient_size);
-      jacobians.push_back(ambient[i].data());
+    const std::vector<StateId>& ids = StatesOf(rid);
+    auto [group_it, inserted] = groups.try_emplace(ids);
+    Group& group = group_it->second;
+    int width = 0;
+    if (inserted) {
+      for (StateId id : ids) {
+        StateInfo& s = info[id];
+        if (s.block == nullptr) {
+          s.block = &Get(id, __LINE__);
+          if (!problem_->IsParameterBlockConstant(s.block->values.get())) {
+            Throw<std::logic_error>(__LINE__, "residual touches state " + std::to_string(id) +
+                                                  " which is neither in the ordering nor constant");
+          }
+        }
+        group.states.push_back(&s);
+        if (s.offset >= 0) width += s.block->tangent_size;
+      }
+      group.H.setZero(width, width);
+      group.b.setZero(width);
     }
-    Eigen::VectorXd r(m);
+    width = static_cast<int>(group.b.size());
+    const ceres::CostFunction* cost = problem_->GetCostFunctionForResidualBlock(rid);
+    const int m = cost->num_residuals();
+    const size_t k = ids.size();
+    parameters.resize(k);
+    jacobians.resize(k);
+    if (ambient.size() < k) ambient.resize(k);
+    for (size_t i = 0; i < k; ++i) {
+      const StateInfo& s = *group.states[i];
+      parameters[i] = s.block->values.get();
+      if (s.offset >= 0) {
+        ambient[i].resize(m, s.block->ambient_size);
+        jacobians[i] = ambient[i].data();
+      } else {
+        jacobians[i] = nullptr;  // constant state: Ceres' contract allows a null Jacobian
+      }
+    }
+    r.resize(m);
     if (!cost->Evaluate(parameters.data(), r.data(), jacobians.data())) {
-      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(states) +
+      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(ids) +
                                               ") failed to evaluate at the current estimate");
     }
-    // Tangent Jacobian of the whole block row: [J₁·P₁, J₂·P₂, …] with P = PlusJacobian.
-    int width = 0;
-    for (StateId s : states) width += Get(s, __LINE__).tangent_size;
-    RowMajorMatrix J(m, width);
+    // Tangent Jacobian [J₁·P₁, J₂·P₂, …] (P = PlusJacobian) over the ordered states.
+    J.resize(m, width);
     int c = 0;
-    for (size_t i = 0; i < states.size(); ++i) {
-      const StateBlock& block = Get(states[i], __LINE__);
-      if (block.manifold == nullptr) {
-        J.middleCols(c, block.tangent_size) = ambient[i];
+    for (size_t i = 0; i < k; ++i) {
+      StateInfo& s = *group.states[i];
+      if (s.offset < 0) continue;
+      const int t = s.block->tangent_size;
+      if (s.block->manifold == nullptr) {
+        J.middleCols(c, t) = ambient[i];
       } else {
-        RowMajorMatrix plus(block.ambient_size, block.tangent_size);
-        block.manifold->PlusJacobian(block.values.get(), plus.data());
-        J.middleCols(c, block.tangent_size) = ambient[i] * plus;
+        if (!s.plus_ready) {
+          s.plus.resize(s.block->ambient_size, t);
+          s.block->manifold->PlusJacobian(s.block->values.get(), s.plus.data());
+          s.plus_ready = true;
+        }
+        // Coefficient-based product: these are tiny (m×7 · 7×6), GEMM's blocking only costs.
+        J.middleCols(c, t).noalias() = ambient[i].lazyProduct(s.plus);
       }
-      c += block.tangent_size;
+      c += t;
     }
     if (!r.allFinite() || !J.allFinite()) {
-      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(states) +
+      Throw<std::runtime_error>(__LINE__, "a residual block on states (" + IdList(ids) +
                                               ") is NaN/Inf at the current estimate");
     }
-    ApplyLoss(loss, &r, &J);
-    // Scatter JᵀJ and Jᵀr into H and b: (column in J, row in H, size) of each ordered state.
-    struct Slot {
-      int column, row, size;
-    };
-    std::vector<Slot> slots;
-    c = 0;
-    for (StateId s : states) {
-      const int size = Get(s, __LINE__).tangent_size;
-      const auto it = offset.find(s);
-      if (it != offset.end()) {
-        slots.push_back({c, it->second, size});
-      } else if (!IsStateConstant(s)) {
-        Throw<std::logic_error>(__LINE__, "residual touches state " + std::to_string(s) +
-                                              " which is neither in the ordering nor constant");
-      }
-      c += size;
+    ApplyLoss(problem_->GetLossFunctionForResidualBlock(rid), &r, &J);
+    if (m == 1) {  // the common case (one lidar point): rank-1 update without GEMM
+      group.H.selfadjointView<Eigen::Lower>().rankUpdate(J.row(0).transpose());
+    } else {
+      group.H.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
     }
-    for (const Slot& i : slots) {
-      const auto Ji = J.middleCols(i.column, i.size);
-      b->segment(i.row, i.size).noalias() += Ji.transpose() * r;
-      for (const Slot& j : slots) {
-        H->block(i.row, j.row, i.size, j.size).noalias() +=
-            Ji.transpose() * J.middleCols(j.column, j.size);
+    group.b.noalias() += J.transpose() * r;
+  }
+
+  H->setZero(n, n);
+  b->setZero(n);
+  for (auto& [ids, group] : groups) {
+    group.H.triangularView<Eigen::StrictlyUpper>() = group.H.transpose();
+    int ci = 0;
+    for (const StateInfo* si : group.states) {
+      if (si->offset < 0) continue;
+      const int ti = si->block->tangent_size;
+      b->segment(si->offset, ti) += group.b.segment(ci, ti);
+      int cj = 0;
+      for (const StateInfo* sj : group.states) {
+        if (sj->offset < 0) continue;
+        const int tj = sj->block->tangent_size;
+        H->block(si->offset, sj->offset, ti, tj) += group.H.block(ci, cj, ti, tj);
+        cj += tj;
       }
+      ci += ti;
     }
   }
 }

@@ -40,6 +40,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <unordered_map>
 #include <vector>
 
 #include "ctlio/manifolds/se3.h"
@@ -146,7 +147,7 @@ class SlidingWindow {
   SlidingWindowOptions options_;
   std::unique_ptr<ceres::Problem> problem_;
   std::map<StateId, StateBlock> states_;
-  std::map<ceres::ResidualBlockId, std::vector<StateId>> residuals_;
+  std::unordered_map<ceres::ResidualBlockId, std::vector<StateId>> residuals_;
 };
 
 }  // namespace ctlio
