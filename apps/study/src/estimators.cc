@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -39,17 +40,17 @@ void CheckPositions(const Trajectory& traj) {
   }
 }
 
-// Adds the Gauss-Newton terms of `cost` at δ = 0 (the problems are linear) into a dense system;
+// Adds the Gauss-Newton terms of `cost` linearised at `at` into a dense system;
 // offsets[b] is the first row of parameter block b.
 void AddFactorDense(const ceres::CostFunction& cost, const std::vector<int>& offsets,
-                    Eigen::MatrixXd* H, Eigen::VectorXd* g) {
+                    const std::vector<const double*>& at, Eigen::MatrixXd* H, Eigen::VectorXd* g) {
   const auto& sizes = cost.parameter_block_sizes();
   const int m = cost.num_residuals();
   std::vector<std::vector<double>> params(sizes.size()), jac(sizes.size());
   std::vector<const double*> pp(sizes.size());
   std::vector<double*> jp(sizes.size());
   for (size_t b = 0; b < sizes.size(); ++b) {
-    params[b].assign(sizes[b], 0.0);
+    params[b].assign(at[b], at[b] + sizes[b]);
     jac[b].assign(static_cast<size_t>(m * sizes[b]), 0.0);
     pp[b] = params[b].data();
     jp[b] = jac[b].data();
@@ -70,12 +71,16 @@ void AddFactorDense(const ceres::CostFunction& cost, const std::vector<int>& off
 }
 
 template <int D>
-TrajectoryEstimate SolveChain(const std::vector<std::unique_ptr<ceres::CostFunction>>& factors,
-                              const std::vector<std::vector<int>>& states, int num_states,
-                              const std::vector<int>& eval_states, const std::vector<int>& nodes) {
+TrajectoryEstimate SolveChain(
+    const std::vector<std::unique_ptr<ceres::CostFunction>>& factors,
+    const std::vector<std::vector<int>>& states, int num_states,
+    const std::vector<int>& eval_states, const std::vector<int>& nodes,
+    const std::vector<typename ChainSmoother<D>::Vector>* linearization = nullptr) {
   ChainSmoother<D> system(num_states);
-  const std::vector<typename ChainSmoother<D>::Vector> x(num_states,
-                                                         ChainSmoother<D>::Vector::Zero());
+  const std::vector<typename ChainSmoother<D>::Vector> x =
+      linearization != nullptr ? *linearization
+                               : std::vector<typename ChainSmoother<D>::Vector>(
+                                     num_states, ChainSmoother<D>::Vector::Zero());
   for (size_t f = 0; f < factors.size(); ++f) system.AddFactor(*factors[f], states[f][0], x);
   std::vector<typename ChainSmoother<D>::Vector> delta;
   std::vector<typename ChainSmoother<D>::Block> cov;
@@ -83,7 +88,7 @@ TrajectoryEstimate SolveChain(const std::vector<std::unique_ptr<ceres::CostFunct
   TrajectoryEstimate est;
   est.nodes = nodes;
   for (int s : eval_states) {
-    est.mean.emplace_back(delta[s]);
+    est.mean.emplace_back(x[s] + delta[s]);
     est.covariance.emplace_back(cov[s]);
   }
   return est;
@@ -131,6 +136,14 @@ InputSchedule BuildInputSchedule(const Trajectory& traj) {
     throw std::invalid_argument(Where(__LINE__) +
                                 "IMU as input needs an accelerometer sample at the first time");
   }
+  // Stretches never exceed the nominal sample period (the smallest spacing of the merged
+  // stream), so that a gap is covered by as many stretches as samples it lost (and a factor
+  // always has >= 2 stretches, see ImuInputFactor).
+  int64_t nominal = std::numeric_limits<int64_t>::max();
+  for (size_t j = 1; j < samples.size(); ++j) {
+    if (samples[j].t > samples[j - 1].t)
+      nominal = std::min(nominal, samples[j].t - samples[j - 1].t);
+  }
   InputSchedule schedule;
   size_t latest = 0;  // newest sample with t <= cur
   for (size_t i = 0; i + 1 < traj.position.size(); ++i) {
@@ -140,7 +153,8 @@ InputSchedule BuildInputSchedule(const Trajectory& traj) {
     int64_t cur = a;
     while (latest + 1 < samples.size() && samples[latest + 1].t <= cur) ++latest;
     while (cur < b) {
-      const int64_t next = latest + 1 < samples.size() ? std::min(b, samples[latest + 1].t) : b;
+      int64_t next = latest + 1 < samples.size() ? std::min(b, samples[latest + 1].t) : b;
+      if (nominal < b - cur) next = std::min(next, cur + nominal);
       const Sample& s = samples[latest];
       stretches.push_back({1e-9 * static_cast<double>(next - cur), s.value,
                            1e-9 * static_cast<double>(cur - s.t), s.sensor});
@@ -272,7 +286,10 @@ TrajectoryEstimate ImuAsMeasurement::Smooth(const Trajectory& traj) const {
   std::vector<std::vector<int>> states;
   const auto factors = Factors(traj, &states);
   const auto nodes = PositionNodes(traj);
-  return SolveChain<3>(factors, states, static_cast<int>(traj.times_ns.size()), nodes, nodes);
+  std::vector<Eigen::Vector3d> filtered;
+  Filter(traj, &filtered);
+  return SolveChain<3>(factors, states, static_cast<int>(traj.times_ns.size()), nodes, nodes,
+                       &filtered);
 }
 
 TrajectoryEstimate ImuAsMeasurement::SmoothPreintegrated(const Trajectory& traj,
@@ -292,12 +309,15 @@ TrajectoryEstimate ImuAsMeasurement::SmoothPreintegrated(const Trajectory& traj,
   }
   // Unary factors on a position-time state go to the chain; everything else to its interval.
   ChainSmoother<3> chain(num_keys);
-  const std::vector<Eigen::Vector3d> zero(num_keys, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> filtered;
+  Filter(traj, &filtered);
+  std::vector<Eigen::Vector3d> x_keys;
+  for (int k : keys) x_keys.push_back(filtered[k]);
   std::vector<std::vector<size_t>> in_interval(num_keys > 1 ? num_keys - 1 : 0);
   for (size_t f = 0; f < factors.size(); ++f) {
     const auto& st = states[f];
     if (st.size() == 1 && key_of[st[0]] >= 0) {
-      chain.AddFactor(*factors[f], key_of[st[0]], zero);
+      chain.AddFactor(*factors[f], key_of[st[0]], x_keys);
     } else {
       in_interval.at(interval_of[st[0]]).push_back(f);
     }
@@ -307,7 +327,8 @@ TrajectoryEstimate ImuAsMeasurement::SmoothPreintegrated(const Trajectory& traj,
     const int local_states = keys[i + 1] - first + 1;
     if (!information_form) {
       ChainSmoother<3> local(local_states);
-      const std::vector<Eigen::Vector3d> x(local_states, Eigen::Vector3d::Zero());
+      const std::vector<Eigen::Vector3d> x(filtered.begin() + first,
+                                           filtered.begin() + first + local_states);
       for (size_t f : in_interval[i]) local.AddFactor(*factors[f], states[f][0] - first, x);
       chain.AddPairRows(i, local.EliminateInterior());
       continue;
@@ -317,8 +338,12 @@ TrajectoryEstimate ImuAsMeasurement::SmoothPreintegrated(const Trajectory& traj,
     Eigen::VectorXd g = Eigen::VectorXd::Zero(m);
     for (size_t f : in_interval[i]) {
       std::vector<int> offsets;
-      for (int s : states[f]) offsets.push_back(3 * (s - first));
-      AddFactorDense(*factors[f], offsets, &H, &g);
+      std::vector<const double*> at;
+      for (int s : states[f]) {
+        offsets.push_back(3 * (s - first));
+        at.push_back(filtered[s].data());
+      }
+      AddFactorDense(*factors[f], offsets, at, &H, &g);
     }
     std::vector<int> keep = {0, 1, 2, m - 3, m - 2, m - 1}, marginalize;
     for (int j = 3; j < m - 3; ++j) marginalize.push_back(j);
@@ -338,14 +363,20 @@ TrajectoryEstimate ImuAsMeasurement::SmoothPreintegrated(const Trajectory& traj,
   TrajectoryEstimate est;
   est.nodes = keys;
   for (int i = 0; i < num_keys; ++i) {
-    est.mean.emplace_back(delta[i]);
+    est.mean.emplace_back(x_keys[i] + delta[i]);
     est.covariance.emplace_back(cov[i]);
   }
   return est;
 }
 
 double ImuAsMeasurement::LogLikelihood(const Trajectory& traj) const {
+  return Filter(traj, nullptr);
+}
+
+double ImuAsMeasurement::Filter(const Trajectory& traj,
+                                std::vector<Eigen::Vector3d>* filtered) const {
   CheckPositions(traj);
+  if (filtered != nullptr) filtered->resize(traj.times_ns.size());
   MotionModelCache cache(prior_);
   Eigen::Vector3d x = sensors_.x0_mean;
   Eigen::Matrix3d P = sensors_.p0_variance * Eigen::Matrix3d::Identity();
@@ -371,6 +402,7 @@ double ImuAsMeasurement::LogLikelihood(const Trajectory& traj) const {
       ll += ScalarUpdate<3>(0, traj.position[pos_cursor].value, rp, &x, &P);
       ++pos_cursor;
     }
+    if (filtered != nullptr) (*filtered)[k] = x;
   }
   return ll;
 }

@@ -95,6 +95,9 @@ class ImuAsInput {
 
 class ImuAsMeasurement {
  public:
+  // The smoothers linearise at the Kalman-filter estimate: the problem is linear, so any point
+  // gives the same solution in exact arithmetic, but starting close keeps the Gauss-Newton step
+  // — and its round-off, which scales with it — small (≈ 1e-3 instead of the trajectory's 10 m).
   ImuAsMeasurement(const SensorModel& sensors, const PriorConfig& prior);
   TrajectoryEstimate Smooth(const Trajectory& traj) const;
   // Same estimate by heterogeneous preintegration (paper Fig. 2, eq. 26, SPEC §3): between each
@@ -113,6 +116,9 @@ class ImuAsMeasurement {
       const Trajectory& traj, std::vector<std::vector<int>>* states) const;
 
  private:
+  // Kalman filter: returns the log-likelihood and optionally the filtered mean at every node.
+  double Filter(const Trajectory& traj, std::vector<Eigen::Vector3d>* filtered) const;
+
   SensorModel sensors_;
   PriorConfig prior_;
 };
