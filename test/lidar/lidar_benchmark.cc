@@ -1,0 +1,174 @@
+// Speed of the lidar front end and factors (SPEC §4, §9): voxel-map insertion and neighbour
+// queries per second, voxel subsampling, the point-to-plane factors with Jacobians, and one
+// registration of a real ~25k-point Newer College sweep (skipped if the data is absent).
+// Report medians: --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <random>
+
+#include "common/gradient_check.h"
+#include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/factors/lidar/point_to_plane.h"
+#include "ctlio/io/point_cloud_io.h"
+#include "ctlio/solvers/lio/frontend.h"
+#include "ctlio/solvers/lio/registration.h"
+#include "ctlio/solvers/lio/voxel_map.h"
+
+namespace ctlio::lio {
+namespace {
+
+const std::string kFolder =
+    std::string(CTLIO_SHARED_DATA_DIR) + "/gtsam_points_lidar_samples/newer_college_2020_06";
+
+// A synthetic outdoor-like sweep: ground plane, walls and clutter within 40 m.
+std::vector<Vec3> SyntheticSweep(int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3> pts(n);
+  for (int i = 0; i < n; ++i) {
+    const double a = M_PI * u(rng), r = 3.0 + 37.0 * std::abs(u(rng));
+    switch (i % 3) {
+      case 0:
+        pts[i] = Vec3(r * std::cos(a), r * std::sin(a), -1.5);
+        break;
+      case 1:
+        pts[i] = Vec3(20.0, 40.0 * u(rng), 5.0 * u(rng));
+        break;
+      default:
+        pts[i] = Vec3(r * std::cos(a), r * std::sin(a), 3.0 * u(rng));
+        break;
+    }
+  }
+  return pts;
+}
+
+void BM_VoxelMapInsert(benchmark::State& state) {
+  const auto pts = SyntheticSweep(25000, 1);
+  for (auto _ : state) {
+    VoxelMap map(VoxelMap::Options{});
+    benchmark::DoNotOptimize(map.Insert(pts));
+  }
+  state.SetItemsProcessed(state.iterations() * pts.size());
+}
+BENCHMARK(BM_VoxelMapInsert)->Unit(benchmark::kMillisecond);
+
+void BM_VoxelMapKNearest(benchmark::State& state) {
+  VoxelMap map(VoxelMap::Options{});
+  for (uint32_t s = 0; s < 8; ++s) map.Insert(SyntheticSweep(25000, 10 + s));
+  const auto queries = SyntheticSweep(4096, 99);
+  std::vector<VoxelMap::Neighbour> out;
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(map.KNearest(queries[i++ & 4095], 20, &out));
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["map_points"] = static_cast<double>(map.num_points());
+}
+BENCHMARK(BM_VoxelMapKNearest);
+
+void BM_VoxelGridSubsample(benchmark::State& state) {
+  std::vector<TimedPoint> sweep;
+  for (const Vec3& p : SyntheticSweep(100000, 2)) sweep.push_back({p, 0.0});
+  const double size = state.range(0) / 10.0;
+  for (auto _ : state) benchmark::DoNotOptimize(VoxelGridSubsample(sweep, size).size());
+  state.SetItemsProcessed(state.iterations() * sweep.size());
+}
+BENCHMARK(BM_VoxelGridSubsample)->Arg(2)->Arg(5)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+PlaneAssociation SomeAssociation() {
+  PlaneAssociation m;
+  m.point_robot = Vec3(10.0, -3.0, 1.0);
+  m.plane_point = Vec3(9.0, -2.0, 0.5);
+  m.plane_normal = Vec3(0.3, 0.4, 0.8).normalized();
+  m.weight = 0.7;
+  return m;
+}
+
+void BM_PointToPlaneWithJacobian(benchmark::State& state) {
+  std::mt19937 rng(3);
+  const auto x = testing::PoseParameters(testing::RandomPose(rng, 1.0, 5.0));
+  const PointToPlane cost(SomeAssociation());
+  const double* params[] = {x.data()};
+  double r, J[7];
+  double* jac[] = {J};
+  for (auto _ : state) {
+    cost.Evaluate(params, &r, jac);
+    benchmark::DoNotOptimize(J[0]);
+  }
+}
+BENCHMARK(BM_PointToPlaneWithJacobian);
+
+void BM_ContinuousPointToPlane(benchmark::State& state) {
+  std::mt19937 rng(4);
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  const gp::SingerModel<6> model(qc, alpha);
+  const SE3 T_k = testing::RandomPose(rng, 1.0, 5.0);
+  const auto pk = testing::PoseParameters(T_k);
+  const auto pk1 = testing::PoseParameters(testing::RandomPose(rng, 0.2, 0.3) * T_k);
+  const Vec6 w_k = testing::RandomVec6(rng, 1.0), a_k = testing::RandomVec6(rng, 5.0);
+  const Vec6 w_k1 = testing::RandomVec6(rng, 1.0), a_k1 = testing::RandomVec6(rng, 5.0);
+  const ContinuousPointToPlane cost(
+      std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.05), SomeAssociation());
+  const double* params[] = {pk.data(),  w_k.data(),  a_k.data(),
+                            pk1.data(), w_k1.data(), a_k1.data()};
+  double r, J0[7], J1[6], J2[6], J3[7], J4[6], J5[6];
+  double* jac[] = {J0, J1, J2, J3, J4, J5};
+  const bool with_jacobians = state.range(0) != 0;
+  for (auto _ : state) {
+    cost.Evaluate(params, &r, with_jacobians ? jac : nullptr);
+    benchmark::DoNotOptimize(r);
+    benchmark::DoNotOptimize(J0[0]);
+  }
+}
+BENCHMARK(BM_ContinuousPointToPlane)->Arg(0)->Arg(1);
+
+// The real-data test's pipeline on sweep 00 (25,109 points): preprocessing, keypoints, rigid
+// fit, then the two-knot continuous-time registration.
+void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
+  if (!std::filesystem::is_directory(kFolder)) {
+    state.SkipWithError("Newer College sweeps not found");
+    return;
+  }
+  const io::PointCloud raw =
+      io::ReadKittiBin(kFolder + "/raw_00.bin", 3, kFolder + "/times_00.bin");
+  const io::PointCloud deskewed = io::ReadKittiBin(kFolder + "/deskewed_00.bin", 3);
+  const Mat3 Rz = Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  std::vector<TimedPoint> sweep(raw.size());
+  double t_end = 0.0;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    sweep[i] = {Rz * raw.points[i], raw.RelativeTime(i)};
+    t_end = std::max(t_end, sweep[i].time);
+  }
+  const LidarFrontendOptions options;
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  const SweepRegistration registration(options, gp::SingerModel<6>(qc, alpha));
+  LidarFrontend map_frontend(options);
+  map_frontend.UpdateMap(deskewed.points, Vec3::Zero());
+  int keypoints = 0;
+  for (auto _ : state) {
+    LidarFrontend frontend(options);
+    const auto kp = frontend.Keypoints(frontend.Preprocess(sweep));
+    keypoints = static_cast<int>(kp.size());
+    SE3 T;
+    registration.RegisterRigid(map_frontend.map(), kp, &T);
+    gp::KnotState k, k1;
+    k.pose = T;
+    k1.pose = T;
+    benchmark::DoNotOptimize(registration.Register(map_frontend.map(), kp, 0.0, t_end, &k, &k1));
+  }
+  state.counters["keypoints"] = keypoints;
+  state.counters["points"] = static_cast<double>(sweep.size());
+}
+BENCHMARK(BM_RegisterNewerCollegeSweep)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace ctlio::lio
+
+BENCHMARK_MAIN();
