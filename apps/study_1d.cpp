@@ -31,6 +31,7 @@ DEFINE_int32(heterogeneous_checks, 3,
 DEFINE_string(output_dir, "study_1d_out", "folder for CSV/JSON/PNG output");
 DEFINE_bool(plot, true, "run tools/plot_study_1d.py on the output");
 DEFINE_string(python, "python3", "python interpreter for the plots (needs matplotlib)");
+DEFINE_bool(main_study, true, "run the main study (default sensors); false: extras only");
 DEFINE_bool(extras, true, "also run 100 Hz/sigma 0.01, IMU dropout and two asynchronous IMUs");
 DEFINE_int32(extra_test, 1000, "test trajectories per dataset in the extra scenarios");
 DEFINE_double(dropout_start, 4.0, "extra scenario: accelerometer dropout start (s)");
@@ -137,6 +138,7 @@ int main(int argc, char** argv) {
           {FLAGS_async_rate_b, FLAGS_async_offset_b, FLAGS_sigma_acc});
       scenarios.insert(scenarios.end(), {low, drop, single, two});
     }
+    if (!FLAGS_main_study) scenarios.erase(scenarios.begin());
 
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream json;
