@@ -15,9 +15,11 @@ namespace {
 std::vector<Trajectory> SimulateSet(const DatasetConfig& dataset, const StudyConfig& config,
                                     int set_id, int count, int threads) {
   std::vector<Trajectory> out(count);
-  ParallelFor(count, threads, [&](int i, int) {
-    out[i] = Simulate(dataset, config.sensors, config.seed, set_id, i);
-  });
+  const SensorConfig& sensors = set_id == kValidationSet && config.validation_sensors
+                                    ? *config.validation_sensors
+                                    : config.sensors;
+  ParallelFor(count, threads,
+              [&](int i, int) { out[i] = Simulate(dataset, sensors, config.seed, set_id, i); });
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,9 @@ namespace ctlio::study {
 
 struct StudyConfig {
   SensorConfig sensors;
+  // Sensors of the validation set when they differ from the test set's (the dropout scenario
+  // trains on nominal data: a dropout is an event at test time, not a property of the sensor).
+  std::optional<SensorConfig> validation_sensors;
   int validation_trajectories = 100;
   int test_trajectories = 1000;
   uint64_t seed = 1;
