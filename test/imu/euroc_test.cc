@@ -31,6 +31,17 @@ bool HaveData() {
   GTEST_SKIP() << "EuRoC V1_01 not found in " << DataDir() \
                << " (set CTLIO_SHARED_DATA_DIR to the shared data folder)"
 
+// Each file is read once per test program (4 MB of text; matters under ASan).
+const std::vector<ImuSample>& Imu() {
+  static const std::vector<ImuSample> imu = ReadEurocImuCsv(DataDir() + "/imu0_data.csv");
+  return imu;
+}
+const std::vector<GroundTruthState>& GroundTruth() {
+  static const std::vector<GroundTruthState> gt =
+      ReadVicon2gtCsv(DataDir() + "/groundtruth_vicon2gt_20hz.csv");
+  return gt;
+}
+
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -46,9 +57,8 @@ ImuNoise EurocNoise() {
 
 TEST(EurocData, ReadsBothFiles) {
   SKIP_WITHOUT_DATA();
-  const std::vector<ImuSample> imu = ReadEurocImuCsv(DataDir() + "/imu0_data.csv");
-  const std::vector<GroundTruthState> gt =
-      ReadVicon2gtCsv(DataDir() + "/groundtruth_vicon2gt_20hz.csv");
+  const std::vector<ImuSample>& imu = Imu();
+  const std::vector<GroundTruthState>& gt = GroundTruth();
   EXPECT_EQ(imu.size(), 29120u);
   EXPECT_EQ(gt.size(), 2895u);
   EXPECT_EQ(imu.front().t_ns, 1403715273262142976LL);
@@ -64,9 +74,8 @@ TEST(EurocData, ReadsBothFiles) {
 // against the ground truth.
 TEST(EurocData, OneSecondPreintegrationWindowsMatchGroundTruth) {
   SKIP_WITHOUT_DATA();
-  const std::vector<ImuSample> imu = ReadEurocImuCsv(DataDir() + "/imu0_data.csv");
-  const std::vector<GroundTruthState> gt =
-      ReadVicon2gtCsv(DataDir() + "/groundtruth_vicon2gt_20hz.csv");
+  const std::vector<ImuSample>& imu = Imu();
+  const std::vector<GroundTruthState>& gt = GroundTruth();
   const Vec3 gravity(0.0, 0.0, -9.81);
   std::vector<double> position_errors, rotation_errors, travelled, unbiased_rotation_errors;
   for (std::size_t i = 0; i + 20 < gt.size(); i += 10) {
@@ -107,9 +116,8 @@ TEST(EurocData, OneSecondPreintegrationWindowsMatchGroundTruth) {
 // bias of the vicon2gt file removed first, roll and pitch are both within 1°.
 TEST(EurocData, GravityInitializationRecoversRollPitch) {
   SKIP_WITHOUT_DATA();
-  const std::vector<ImuSample> imu = ReadEurocImuCsv(DataDir() + "/imu0_data.csv");
-  const std::vector<GroundTruthState> gt =
-      ReadVicon2gtCsv(DataDir() + "/groundtruth_vicon2gt_20hz.csv");
+  const std::vector<ImuSample>& imu = Imu();
+  const std::vector<GroundTruthState>& gt = GroundTruth();
   double roll, pitch;
   RollPitch(gt.front().x.C, &roll, &pitch);
   for (const bool with_bias : {false, true}) {
@@ -134,7 +142,7 @@ TEST(EurocData, GravityInitializationRecoversRollPitch) {
 
 TEST(EurocData, GravityInitializationRejectsMotion) {
   SKIP_WITHOUT_DATA();
-  const std::vector<ImuSample> imu = ReadEurocImuCsv(DataDir() + "/imu0_data.csv");
+  const std::vector<ImuSample>& imu = Imu();
   // 30 s in, the MAV is flying.
   try {
     InitializeGravity(imu, imu.front().t_ns + 30'000'000'000LL, 1'000'000'000);
