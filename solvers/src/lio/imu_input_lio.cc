@@ -159,7 +159,7 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
       const Vec3 q = T_end_inv * (table.Interpolate(p.time) * p.point);
       PlaneAssociation a;
       if (!associator.Associate(q, T_wb * q, &a)) continue;
-      a.weight /= config_.point_to_plane_std;
+      a.weight /= config_.frontend.point_noise_sigma;
       lidar_blocks.push_back(
           problem_.AddResidualBlock(new PointToPlaneWorld(a), lidar_loss_.get(), s.pose));
     }

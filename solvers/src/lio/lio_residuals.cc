@@ -8,7 +8,7 @@
 namespace ctlio::lio {
 
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const OdometryConfig& config) {
-  const double scale = config.frontend.loss_scale / config.point_to_plane_std;
+  const double scale = config.frontend.loss_scale / config.frontend.point_noise_sigma;
   if (config.frontend.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale);
   if (config.frontend.loss == "huber") return std::make_unique<ceres::HuberLoss>(scale);
   return nullptr;

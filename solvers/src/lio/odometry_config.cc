@@ -114,7 +114,6 @@ void OdometryConfig::Validate() const {
   require(input_accel_sigma > 0 && input_gyro_sigma > 0 && imu_rate_hint > 0,
           "imu input noise densities and rate must be positive");
   require(gravity_init_duration >= 0 && gravity_init_max_std > 0, "bad init parameters");
-  require(point_to_plane_std > 0, "lidar.point_to_plane_std must be positive");
   require(min_associations >= 0, "init.min_associations must be >= 0");
   require(max_imu_gap > 0, "init.max_imu_gap must be positive");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
@@ -152,8 +151,6 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
                    {"input_accel_sigma", Set(&c.input_accel_sigma)},
                    {"input_gyro_sigma", Set(&c.input_gyro_sigma)},
                    {"rate_hint", Set(&c.imu_rate_hint)}});
-    } else if (key == "lidar") {
-      ReadSection(v, key, source, {{"point_to_plane_std", Set(&c.point_to_plane_std)}});
     } else if (key == "init") {
       ReadSection(v, key, source,
                   {{"gravity_duration", Set(&c.gravity_init_duration)},

@@ -187,7 +187,7 @@ void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
       }
       PlaneAssociation a;
       if (!associator.Associate(p.point, T_mr_tau * p.point, &a)) continue;
-      a.weight /= config_.point_to_plane_std;
+      a.weight /= config_.frontend.point_noise_sigma;
       lidar_blocks.push_back(problem_.AddResidualBlock(
           new FiringPointToPlane(shared, a), lidar_loss_.get(), prev.pose, prev.velocity,
           prev.acceleration, k.pose, k.velocity, k.acceleration));

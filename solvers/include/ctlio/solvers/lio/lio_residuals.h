@@ -21,7 +21,7 @@
 namespace ctlio::lio {
 
 // The front end's loss (cauchy/huber/none, scale in metres), applied to the residual divided by
-// config.point_to_plane_std, hence scaled by the same factor. nullptr for "none".
+// config.frontend.point_noise_sigma, hence scaled by the same factor. nullptr for "none".
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const OdometryConfig& config);
 
 // Dense normal Cholesky: a window of two or three knots has < 60 tangent parameters, where the

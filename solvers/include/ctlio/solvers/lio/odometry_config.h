@@ -60,10 +60,8 @@ struct OdometryConfig {
   double input_gyro_sigma = 0.01;   // rad/s, per sample at rate_hint
   double imu_rate_hint = 200.0;     // Hz, for the densities above
 
-  // --- Lidar residual: the point-to-plane error (already weighted by the planarity weight) is
-  // divided by this standard deviation so that it is commensurate with the whitened IMU and
-  // prior terms; the front end's loss scale stays in metres.
-  double point_to_plane_std = 0.05;  // m
+  // (The lidar residual's standard deviation is frontend.point_noise_sigma: the planarity-weighted
+  // point-to-plane error is divided by it, and the loss scale stays in metres.)
 
   // --- Initialisation and robustness.
   double gravity_init_duration = 0.2;  // s of accelerometer averaged while still at start
