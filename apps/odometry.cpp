@@ -7,8 +7,8 @@
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
-// alignment). Several methods separated by commas run one after the other and print their ATE
-// side by side.
+// alignment) with DIR/trajectory_topview.svg (estimate over ground truth). Several methods
+// separated by commas run one after the other and print their ATE side by side.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -126,6 +126,11 @@ int main(int argc, char** argv) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
         io::WriteTum(out + "/ground_truth.tum", *source->GroundTruth());
+        char title[160];
+        std::snprintf(title, sizeof(title), "%s on %s: ATE %.4f m", run.method.c_str(),
+                      run.source.c_str(), run.ate->rmse);
+        lioapp::WriteTopViewSvg(out + "/trajectory_topview.svg", run.trajectory,
+                                *source->GroundTruth(), run.ate->alignment, title);
       }
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       runs.push_back(std::move(run));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -61,6 +62,7 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
   }
   // SE(3) alignment (no scale): Umeyama (1991) as implemented by Eigen.
   const Eigen::Matrix4d T = Eigen::umeyama(A, B, false);
+  r.alignment = T;
   double sum2 = 0.0;
   for (size_t i = 0; i < est.size(); ++i) {
     const double e =
@@ -142,6 +144,47 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   run.failure =
       run.failed > 0 || (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
   return run;
+}
+
+void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment,
+                     const std::string& title) {
+  std::vector<Vec3> est, ref;
+  for (const auto& p : estimate) {
+    est.push_back(alignment.topLeftCorner<3, 3>() * p.pose.translation() +
+                  alignment.topRightCorner<3, 1>());
+  }
+  const int64_t t0 = estimate.empty() ? 0 : estimate.front().t_ns;
+  const int64_t t1 = estimate.empty() ? 0 : estimate.back().t_ns;
+  for (const auto& p : truth) {
+    if (p.t_ns >= t0 && p.t_ns <= t1) ref.push_back(p.pose.translation());
+  }
+  Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
+  for (const auto* v : {&est, &ref}) {
+    for (const Vec3& p : *v) {
+      lo = lo.cwiseMin(p.head<2>());
+      hi = hi.cwiseMax(p.head<2>());
+    }
+  }
+  const double span = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3});
+  const double size = 600, margin = 40, scale = (size - 2 * margin) / span;
+  auto polyline = [&](const std::vector<Vec3>& v, const char* colour, double width) {
+    std::ostringstream s;
+    s << "<polyline fill='none' stroke='" << colour << "' stroke-width='" << width << "' points='";
+    for (const Vec3& p : v) {
+      s << margin + (p.x() - lo.x()) * scale << ',' << size - margin - (p.y() - lo.y()) * scale
+        << ' ';
+    }
+    s << "'/>\n";
+    return s.str();
+  };
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot write the plot");
+  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << size << "' height='" << size + 30
+    << "'>\n<rect width='100%' height='100%' fill='white'/>\n"
+    << "<text x='10' y='20' font-family='sans-serif' font-size='14'>" << title
+    << " (top view; grey: ground truth, red: estimate; frame " << span << " m)</text>\n"
+    << polyline(ref, "#888888", 3) << polyline(est, "#d62728", 1.5) << "</svg>\n";
 }
 
 void WriteScanLog(const std::string& path, const RunSummary& run) {

@@ -4,6 +4,7 @@
 // ctlio_experiment.
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <optional>
 #include <string>
@@ -25,6 +26,7 @@ struct AteResult {
   double mean = 0.0;
   double max = 0.0;
   size_t pairs = 0;
+  Eigen::Matrix4d alignment = Eigen::Matrix4d::Identity();  // estimate → truth frame
 };
 
 struct RunSummary {
@@ -55,6 +57,12 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
 // Per-scan log: t, status, keypoints, associations, imu residuals, rounds, solver iterations,
 // final cost, ms, position, message.
 void WriteScanLog(const std::string& path, const RunSummary& run);
+
+// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file: no
+// plotting dependency needed.
+void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment,
+                     const std::string& title);
 
 long PeakRssKb();
 double Percentile(std::vector<double> v, double p);
