@@ -178,7 +178,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
     std::ofstream out(dir / "ctlio_sim.yaml");
-    out << "# ctlio simulator dataset, layout in apps/io/FORMAT.md\n" << y.c_str() << "\n";
+    out << "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" << y.c_str() << "\n";
     if (!out) throw std::runtime_error((dir / "ctlio_sim.yaml").string() + ": write failed");
   }
   std::ofstream imu(dir / "imu.csv"), scans(dir / "scans.csv");

@@ -1,4 +1,4 @@
-// ctlio's own simulator folder layout (documented in apps/io/FORMAT.md):
+// ctlio's own simulator folder layout (documented in README.md, "Dataset folders"):
 //   ctlio_sim.yaml        format: ctlio_sim, version: 1, gravity, imu_from_lidar, free `config`
 //   imu.csv               header "t_ns,wx,wy,wz,ax,ay,az"
 //   scans.csv             header "index,start_ns,end_ns,points,file"
