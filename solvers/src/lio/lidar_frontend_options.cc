@@ -4,26 +4,13 @@
 
 #include <functional>
 #include <map>
-#include <sstream>
 #include <stdexcept>
+
+#include "ctlio/solvers/lio/yaml_io.h"
 
 namespace ctlio::lio {
 
-namespace {
-
-std::string Where(const std::string& source, const YAML::Mark& mark) {
-  std::ostringstream s;
-  s << source;
-  if (mark.line >= 0) s << ":" << mark.line + 1;
-  return s.str();
-}
-
-template <typename T>
-std::function<void(const YAML::Node&)> Setter(T* field) {
-  return [field](const YAML::Node& value) { *field = value.as<T>(); };
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void LidarFrontendOptions::Validate() const {
   auto require = [](bool ok, const char* what) {
@@ -54,42 +41,43 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
   LidarFrontendOptions o;
   if (!node.IsDefined() || node.IsNull()) return o;
   if (!node.IsMap()) {
-    throw std::runtime_error(Where(source, node.Mark()) +
+    throw std::runtime_error(YamlWhere(source, node.Mark()) +
                              ": lidar front-end options must be a YAML mapping");
   }
   const std::map<std::string, std::function<void(const YAML::Node&)>> fields = {
-      {"min_range", Setter(&o.min_range)},
-      {"max_range", Setter(&o.max_range)},
-      {"voxel_size", Setter(&o.voxel_size)},
-      {"initial_voxel_size", Setter(&o.initial_voxel_size)},
-      {"initial_scans", Setter(&o.initial_scans)},
-      {"keypoint_voxel_size", Setter(&o.keypoint_voxel_size)},
-      {"map_voxel_size", Setter(&o.map_voxel_size)},
-      {"max_points_per_voxel", Setter(&o.max_points_per_voxel)},
-      {"min_point_distance", Setter(&o.min_point_distance)},
-      {"max_map_distance", Setter(&o.max_map_distance)},
-      {"max_neighbours", Setter(&o.max_neighbours)},
-      {"min_neighbours", Setter(&o.min_neighbours)},
-      {"max_plane_distance", Setter(&o.max_plane_distance)},
-      {"max_iterations", Setter(&o.max_iterations)},
-      {"solver_iterations", Setter(&o.solver_iterations)},
-      {"point_noise_sigma", Setter(&o.point_noise_sigma)},
-      {"loss", Setter(&o.loss)},
-      {"loss_scale", Setter(&o.loss_scale)},
-      {"convergence_translation", Setter(&o.convergence_translation)},
-      {"convergence_rotation", Setter(&o.convergence_rotation)},
+      {"min_range", SetFromYaml(&o.min_range)},
+      {"max_range", SetFromYaml(&o.max_range)},
+      {"voxel_size", SetFromYaml(&o.voxel_size)},
+      {"initial_voxel_size", SetFromYaml(&o.initial_voxel_size)},
+      {"initial_scans", SetFromYaml(&o.initial_scans)},
+      {"keypoint_voxel_size", SetFromYaml(&o.keypoint_voxel_size)},
+      {"map_voxel_size", SetFromYaml(&o.map_voxel_size)},
+      {"max_points_per_voxel", SetFromYaml(&o.max_points_per_voxel)},
+      {"min_point_distance", SetFromYaml(&o.min_point_distance)},
+      {"max_map_distance", SetFromYaml(&o.max_map_distance)},
+      {"max_neighbours", SetFromYaml(&o.max_neighbours)},
+      {"min_neighbours", SetFromYaml(&o.min_neighbours)},
+      {"max_plane_distance", SetFromYaml(&o.max_plane_distance)},
+      {"max_iterations", SetFromYaml(&o.max_iterations)},
+      {"solver_iterations", SetFromYaml(&o.solver_iterations)},
+      {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},
+      {"loss", SetFromYaml(&o.loss)},
+      {"loss_scale", SetFromYaml(&o.loss_scale)},
+      {"convergence_translation", SetFromYaml(&o.convergence_translation)},
+      {"convergence_rotation", SetFromYaml(&o.convergence_rotation)},
   };
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
     const auto it = fields.find(key);
     if (it == fields.end()) {
-      throw std::runtime_error(Where(source, kv.first.Mark()) + ": unknown lidar front-end key '" +
-                               key + "'");
+      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) +
+                               ": unknown lidar front-end key '" + key + "'");
     }
     try {
       it->second(kv.second);
     } catch (const YAML::Exception&) {
-      throw std::runtime_error(Where(source, kv.second.Mark()) + ": bad value for '" + key + "'");
+      throw std::runtime_error(YamlWhere(source, kv.second.Mark()) + ": bad value for '" + key +
+                               "'");
     }
   }
   try {
@@ -101,14 +89,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
 }
 
 LidarFrontendOptions LoadLidarFrontendOptions(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(path + ": cannot open lidar front-end options");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(Where(path, e.mark) + ": " + e.msg);
-  }
+  const YAML::Node root = LoadYamlFile(path, "lidar front-end options");
   // Accept either the options at the top level or under a "lidar_frontend" key, so that the
   // same block can live inside a larger pipeline config.
   const YAML::Node& const_root = root;

@@ -4,26 +4,15 @@
 
 #include <functional>
 #include <map>
-#include <sstream>
 #include <stdexcept>
+
+#include "ctlio/solvers/lio/yaml_io.h"
 
 namespace ctlio::lio {
 
 namespace {
 
-std::string Where(const std::string& source, const YAML::Mark& mark) {
-  std::ostringstream s;
-  s << source;
-  if (mark.line >= 0) s << ":" << mark.line + 1;
-  return s.str();
-}
-
-using Setter = std::function<void(const YAML::Node&)>;
-
-template <typename T>
-Setter Set(T* field) {
-  return [field](const YAML::Node& v) { *field = v.as<T>(); };
-}
+using Setter = YamlSetter;
 
 Setter SetVec6(Vec6* field) {
   return [field](const YAML::Node& v) {
@@ -37,20 +26,20 @@ void ReadSection(const YAML::Node& node, const std::string& section, const std::
                  const std::map<std::string, Setter>& fields) {
   if (!node.IsDefined() || node.IsNull()) return;
   if (!node.IsMap()) {
-    throw std::runtime_error(Where(source, node.Mark()) + ": '" + section +
+    throw std::runtime_error(YamlWhere(source, node.Mark()) + ": '" + section +
                              "' must be a YAML mapping");
   }
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
     const auto it = fields.find(key);
     if (it == fields.end()) {
-      throw std::runtime_error(Where(source, kv.first.Mark()) + ": unknown key '" + section + "." +
-                               key + "'");
+      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + section +
+                               "." + key + "'");
     }
     try {
       it->second(kv.second);
     } catch (const YAML::Exception&) {
-      throw std::runtime_error(Where(source, kv.second.Mark()) + ": bad value for '" + section +
+      throw std::runtime_error(YamlWhere(source, kv.second.Mark()) + ": bad value for '" + section +
                                "." + key + "'");
     }
   }
@@ -138,36 +127,36 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
       ReadSection(v, key, source, {{"qc", SetVec6(&c.qc)}, {"alpha", SetVec6(&c.alpha)}});
     } else if (key == "imu") {
       ReadSection(v, key, source,
-                  {{"accel_variance", Set(&c.accel_variance)},
-                   {"accel_loss_scale", Set(&c.accel_loss_scale)},
-                   {"gyro_variance", Set(&c.gyro_variance)},
-                   {"bias_accel_walk", Set(&c.bias_accel_walk)},
-                   {"bias_gyro_walk", Set(&c.bias_gyro_walk)},
-                   {"bias_walk_period", Set(&c.bias_walk_period)},
-                   {"initial_bias_accel_variance", Set(&c.initial_bias_accel_variance)},
-                   {"initial_bias_gyro_variance", Set(&c.initial_bias_gyro_variance)},
-                   {"gravity", Set(&c.gravity)},
-                   {"exact_specific_force", Set(&c.exact_specific_force)},
-                   {"input_accel_sigma", Set(&c.input_accel_sigma)},
-                   {"input_gyro_sigma", Set(&c.input_gyro_sigma)},
-                   {"rate_hint", Set(&c.imu_rate_hint)}});
+                  {{"accel_variance", SetFromYaml(&c.accel_variance)},
+                   {"accel_loss_scale", SetFromYaml(&c.accel_loss_scale)},
+                   {"gyro_variance", SetFromYaml(&c.gyro_variance)},
+                   {"bias_accel_walk", SetFromYaml(&c.bias_accel_walk)},
+                   {"bias_gyro_walk", SetFromYaml(&c.bias_gyro_walk)},
+                   {"bias_walk_period", SetFromYaml(&c.bias_walk_period)},
+                   {"initial_bias_accel_variance", SetFromYaml(&c.initial_bias_accel_variance)},
+                   {"initial_bias_gyro_variance", SetFromYaml(&c.initial_bias_gyro_variance)},
+                   {"gravity", SetFromYaml(&c.gravity)},
+                   {"exact_specific_force", SetFromYaml(&c.exact_specific_force)},
+                   {"input_accel_sigma", SetFromYaml(&c.input_accel_sigma)},
+                   {"input_gyro_sigma", SetFromYaml(&c.input_gyro_sigma)},
+                   {"rate_hint", SetFromYaml(&c.imu_rate_hint)}});
     } else if (key == "init") {
       ReadSection(v, key, source,
-                  {{"gravity_duration", Set(&c.gravity_init_duration)},
-                   {"gravity_max_std", Set(&c.gravity_init_max_std)},
-                   {"min_associations", Set(&c.min_associations)},
-                   {"max_imu_gap", Set(&c.max_imu_gap)},
-                   {"max_scan_translation", Set(&c.max_scan_translation)}});
+                  {{"gravity_duration", SetFromYaml(&c.gravity_init_duration)},
+                   {"gravity_max_std", SetFromYaml(&c.gravity_init_max_std)},
+                   {"min_associations", SetFromYaml(&c.min_associations)},
+                   {"max_imu_gap", SetFromYaml(&c.max_imu_gap)},
+                   {"max_scan_translation", SetFromYaml(&c.max_scan_translation)}});
     } else if (key == "window") {
       ReadSection(v, key, source,
-                  {{"knots", Set(&c.window_knots)},
-                   {"threads", Set(&c.solver_threads)},
-                   {"estimate_gravity", Set(&c.estimate_gravity)}});
+                  {{"knots", SetFromYaml(&c.window_knots)},
+                   {"threads", SetFromYaml(&c.solver_threads)},
+                   {"estimate_gravity", SetFromYaml(&c.estimate_gravity)}});
     } else if (key == "extrinsic") {
       have_extrinsic = true;
       ReadSection(v, key, source,
                   {{"xyz_rpy", SetVec6(&extrinsic_xyz_rpy)},
-                   {"rotation", Set(&extrinsic_rotation)},
+                   {"rotation", SetFromYaml(&extrinsic_rotation)},
                    {"translation", [&](const YAML::Node& n) {
                       const auto t = n.as<std::vector<double>>();
                       if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
@@ -176,7 +165,7 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
     } else if (key == "lidar_frontend") {
       c.frontend = LidarFrontendOptionsFromYaml(v, source);
     } else {
-      throw std::runtime_error(Where(source, kv.first.Mark()) + ": unknown key '" + key + "'");
+      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + key + "'");
     }
   }
   try {
@@ -209,15 +198,7 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
 }
 
 OdometryConfig LoadOdometryConfig(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(path + ": cannot open odometry config");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(Where(path, e.mark) + ": " + e.msg);
-  }
-  return OdometryConfigFromYaml(root, path);
+  return OdometryConfigFromYaml(LoadYamlFile(path, "odometry config"), path);
 }
 
 }  // namespace ctlio::lio
