@@ -108,36 +108,85 @@ TEST(EurocData, OneSecondPreintegrationWindowsMatchGroundTruth) {
   EXPECT_GT(Median(unbiased_rotation_errors), 2.0);
 }
 
-// (b) gravity initialisation on the still start (first second, rotors
-// spinning) against the ground-truth attitude of the IMU. Its pitch is −67.6°,
-// where roll is ill-conditioned: a tilt error ε moves roll by up to
-// ε/cos(pitch) = 2.6ε. At a cold start (no bias known) the tilt error and the
-// pitch are within 1° and roll within 1.5°; with the ground-truth accelerometer
-// bias of the vicon2gt file removed first, roll and pitch are both within 1°.
+// (b) gravity initialisation on the still start against the ground-truth attitude of the IMU.
+// What is compared. The accelerometer observes only the gravity direction in the IMU frame, so
+// the error is the tilt: the rotation δ (world frame, horizontal, TiltErrorVector) between the
+// true attitude and the closest attitude with the estimated gravity direction. Its components
+// δ_x, δ_y are the roll and pitch errors about the fixed world axes; |δ| is the total tilt error.
+// ZYX-Euler roll/pitch are NOT used for the bound: this IMU's x axis points almost straight up
+// (pitch −67.6°), where the Euler parametrisation is near its singularity and a tilt error ε
+// moves Euler roll by up to ε/cos(pitch) = 2.6ε, the excess being a rotation about the vertical
+// (the unobservable yaw), not an error in the gravity direction. They are printed beside δ.
+// The window: the first second. The ground truth is still there (asserted below) for ~5 s;
+// longer (2–3 s) or later (0.1–0.5 s in) windows give tilt errors 0.54–0.60° at a cold start
+// (measured), so neither more samples nor skipping the first ones changes the result: it is not
+// noise. It is the accelerometer bias, unobservable while still: with the vicon2gt bias removed
+// the tilt error drops from 0.58° to 0.20°.
 TEST(EurocData, GravityInitializationRecoversRollPitch) {
   SKIP_WITHOUT_DATA();
   const std::vector<ImuSample>& imu = Imu();
   const std::vector<GroundTruthState>& gt = GroundTruth();
+  const std::int64_t t0 = imu.front().t_ns, duration = 1'000'000'000;
+  // The window is still according to the ground truth: speed < 2 cm/s, attitude within 0.2°.
+  ASSERT_EQ(gt.front().t_ns, t0);
+  for (const GroundTruthState& s : gt) {
+    if (s.t_ns >= t0 + duration) break;
+    EXPECT_LT(s.x.v.norm(), 0.02);
+    EXPECT_LT(so3::Log(gt.front().x.C.transpose() * s.x.C).norm() * kRadToDeg, 0.2);
+  }
+  const Mat3& C_gt = gt.front().x.C;
   double roll, pitch;
-  RollPitch(gt.front().x.C, &roll, &pitch);
+  RollPitch(C_gt, &roll, &pitch);
+  const double yaw = std::atan2(C_gt(1, 0), C_gt(0, 0));
   for (const bool with_bias : {false, true}) {
     GravityInitializationOptions options;
     if (with_bias) options.accel_bias = gt.front().bias.head<3>();
-    const GravityInitialization init =
-        InitializeGravity(imu, imu.front().t_ns, 1'000'000'000, options);
-    const double tilt = TiltError(init.C_mi, gt.front().x.C) * kRadToDeg;
+    const GravityInitialization init = InitializeGravity(imu, t0, duration, options);
+    const double tilt = TiltError(init.C_mi, C_gt) * kRadToDeg;
+    const Vec3 delta = TiltErrorVector(init.C_mi, C_gt) * kRadToDeg;
+    // The brief's definition: Log(C_est C_gtᵀ) of the Euler estimate with the true yaw, its
+    // vertical component removed. Equal to δ up to second order.
+    const Mat3 C_euler = so3::Exp(Vec3(0, 0, yaw)) * so3::Exp(Vec3(0, init.pitch, 0)) *
+                         so3::Exp(Vec3(init.roll, 0, 0));
+    const Vec3 log_error = so3::Log(C_euler * C_gt.transpose()) * kRadToDeg;
+    const double euler_roll_error = std::remainder(init.roll - roll, 2 * kPi) * kRadToDeg;
+    const double euler_pitch_error = std::remainder(init.pitch - pitch, 2 * kPi) * kRadToDeg;
     std::printf(
-        "gravity init (%s): tilt error %.3f deg; roll %.3f deg (truth %.3f), pitch %.3f deg "
-        "(truth %.3f); accel scatter %.3f m/s^2, block accel deviation %.3f m/s^2, block gyro "
-        "%.3f rad/s\n",
-        with_bias ? "ground-truth accel bias removed" : "cold start", tilt, init.roll * kRadToDeg,
-        roll * kRadToDeg, init.pitch * kRadToDeg, pitch * kRadToDeg, init.accel_std,
-        init.max_block_accel_deviation, init.max_block_gyro_rate);
+        "gravity init (%s): tilt error %.3f deg = about world x %.3f, world y %.3f deg "
+        "[Log(C_est C_gt^T): x %.3f, y %.3f, vertical %.3f deg]; ZYX Euler: roll %.3f (truth "
+        "%.3f, error %.3f), pitch %.3f (truth %.3f, error %.3f) deg; accel scatter %.3f m/s^2, "
+        "block accel deviation %.3f m/s^2, block gyro %.3f rad/s\n",
+        with_bias ? "ground-truth accel bias removed" : "cold start", tilt, delta.x(), delta.y(),
+        log_error.x(), log_error.y(), log_error.z(), init.roll * kRadToDeg, roll * kRadToDeg,
+        euler_roll_error, init.pitch * kRadToDeg, pitch * kRadToDeg, euler_pitch_error,
+        init.accel_std, init.max_block_accel_deviation, init.max_block_gyro_rate);
+    EXPECT_NEAR(delta.norm(), tilt, 1e-9);
+    EXPECT_NEAR(delta.z(), 0.0, 1e-12);
+    EXPECT_LT(std::abs(delta.x() - log_error.x()), 0.02);
+    EXPECT_LT(std::abs(delta.y() - log_error.y()), 0.02);
+    // The requirement: roll and pitch (about the world axes) and the tilt within 1°.
+    EXPECT_LT(std::abs(delta.x()), 1.0);
+    EXPECT_LT(std::abs(delta.y()), 1.0);
     EXPECT_LT(tilt, 1.0);
-    EXPECT_LT(std::abs(std::remainder(init.pitch - pitch, 2 * kPi)) * kRadToDeg, 1.0);
-    EXPECT_LT(std::abs(std::remainder(init.roll - roll, 2 * kPi)) * kRadToDeg,
-              with_bias ? 1.0 : 1.5);
+    // The bias is the dominant cold-start error (0.58° → 0.20° without it).
+    if (with_bias) EXPECT_LT(tilt, 0.3);
   }
+}
+
+TEST(GravityInitialization, TiltErrorVectorIsTheHorizontalAttitudeError) {
+  // Truth and an estimate that differs by a known small rotation about world x then y, plus a
+  // yaw that the tilt must ignore; at a near-singular Euler attitude (x axis up) and a level one.
+  for (const double truth_pitch : {-1.18, 0.1}) {
+    const Mat3 C_gt =
+        so3::Exp(Vec3(0, 0, 0.7)) * so3::Exp(Vec3(0, truth_pitch, 0)) * so3::Exp(Vec3(3.13, 0, 0));
+    const Vec3 d(0.004, -0.007, 0.0);
+    const Mat3 C_est = so3::Exp(Vec3(0, 0, 0.3)) * so3::Exp(d) * C_gt;  // yaw error 0.3 rad
+    const Mat3 C_mi = C_est.transpose();  // map = robot frame: C_mi e_z = up in the robot frame
+    const Vec3 delta = TiltErrorVector(C_mi, C_gt);
+    EXPECT_LT((delta - d).norm(), 1e-12) << delta.transpose();  // the yaw error is ignored
+    EXPECT_NEAR(delta.norm(), TiltError(C_mi, C_gt), 1e-12);
+  }
+  EXPECT_NEAR(TiltErrorVector(Mat3::Identity(), so3::Exp(Vec3(kPi, 0, 0))).norm(), kPi, 1e-12);
 }
 
 TEST(EurocData, GravityInitializationRejectsMotion) {

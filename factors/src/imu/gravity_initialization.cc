@@ -111,6 +111,18 @@ double TiltError(const Mat3& C_mi, const Mat3& C_wb_truth) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
 }
 
+Vec3 TiltErrorVector(const Mat3& C_mi, const Mat3& C_wb_truth) {
+  // Estimated up direction (robot frame) mapped to the world with the true attitude; the
+  // rotation about w × e_z that takes it to e_z is C_est C_wbᵀ.
+  const Vec3 w = C_wb_truth * (C_mi * Vec3::UnitZ());
+  const Vec3 axis = w.cross(Vec3::UnitZ());
+  const double s = axis.norm();
+  if (s == 0.0) {  // exact, or upside down (then any horizontal axis is a smallest rotation)
+    return w.z() > 0.0 ? Vec3::Zero() : Vec3(std::acos(-1.0), 0.0, 0.0);
+  }
+  return axis * (std::atan2(s, w.z()) / s);
+}
+
 void RollPitch(const Mat3& C_wb, double* roll, double* pitch) {
   // Third row of R_z R_y R_x = [−sinθ, sinφ cosθ, cosφ cosθ].
   *pitch = std::asin(std::clamp(-C_wb(2, 0), -1.0, 1.0));

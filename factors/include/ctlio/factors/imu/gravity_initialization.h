@@ -57,6 +57,14 @@ GravityInitialization InitializeGravity(const std::vector<ImuSample>& samples, s
 // alone is ill-conditioned near pitch ±90° (its error grows like 1/cos(pitch)).
 double TiltError(const Mat3& C_mi, const Mat3& C_wb_truth);
 
+// The same error as a rotation vector in the (z-up) world frame: δ = Log(C_est C_wb_truthᵀ) for
+// the attitude C_est that has the estimated gravity direction and is closest to the truth (the
+// unobservable yaw taken from the truth). δ_z = 0 by construction; δ_x and δ_y are the errors
+// about the world x and y axes — roll and pitch measured about fixed horizontal axes, well
+// conditioned at every attitude — and |δ| = TiltError. To first order δ equals the horizontal
+// part of Log(C_euler C_wb_truthᵀ), C_euler = R_z(yaw_truth)R_y(pitch_est)R_x(roll_est).
+Vec3 TiltErrorVector(const Mat3& C_mi, const Mat3& C_wb_truth);
+
 // Roll and pitch (ZYX Euler, C = R_z(yaw)R_y(pitch)R_x(roll)) of a body → world
 // rotation in a z-up world: the reference the estimate is compared with.
 void RollPitch(const Mat3& C_wb, double* roll, double* pitch);
