@@ -55,6 +55,74 @@ void BM_AccelMeasurementWithJacobians(benchmark::State& state) {
 }
 BENCHMARK(BM_AccelMeasurementWithJacobians)->Arg(0)->Arg(1);
 
+// The accelerometer factor as it was before GpInterpolator::StateRows (full 18×18 state
+// Jacobians, then the three rows it reads): the "before" of the speed-up, in the same run.
+void BM_AccelMeasurementWithJacobiansFullState(benchmark::State& state) {
+  Knots k;
+  const gp::GpInterpolator interp(Model(), 0.0, 0.1, 0.043);
+  const Mat3 S = SqrtInformation(0.156 * Mat3::Identity());
+  const Vec3 accel(0.1, 0.2, 9.8), g_i(0, 0, -9.81);
+  double r[3];
+  for (auto _ : state) {
+    const gp::KnotState a = gp::ReadKnotState(k.params[0], k.params[1], k.params[2]);
+    const gp::KnotState b = gp::ReadKnotState(k.params[3], k.params[4], k.params[5]);
+    const Mat3 C_mi = RotationManifold::Rotation(k.params[8]);
+    gp::KnotState x;
+    gp::StateJacobian J_k, J_k1;
+    interp.State(a, b, &x, &J_k, &J_k1);
+    const Vec3 g_r = x.pose.rotation() * (C_mi * g_i);
+    const Vec3 ba = 0.57 * Eigen::Map<const Vec3>(k.b_k) + 0.43 * Eigen::Map<const Vec3>(k.b_k1);
+    Eigen::Map<Vec3>{r} = S * (accel + x.acceleration.head<3>() + g_r - ba);
+    const Mat3 G = -so3::Hat(g_r);
+    for (int i = 0; i < 2; ++i) {
+      const gp::StateJacobian& J = i == 0 ? J_k : J_k1;
+      Eigen::Matrix<double, 3, 18> DJ = J.middleRows<3>(12);
+      DJ.noalias() += G * J.middleRows<3>(3);
+      const Eigen::Matrix<double, 3, 18> W = S * DJ;
+      LiftPoseJacobian<3>(W.leftCols<6>(), k.params[3 * i], k.jacobians[3 * i]);
+      Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>{k.jacobians[3 * i + 1]} =
+          W.middleCols<6>(6);
+      Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>>{k.jacobians[3 * i + 2]} =
+          W.rightCols<6>();
+    }
+    for (int i = 0; i < 2; ++i) {
+      Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> J{k.jacobians[6 + i]};
+      J.leftCols<3>() = -(i == 0 ? 0.57 : 0.43) * S;
+      J.rightCols<3>().setZero();
+    }
+    LiftRotationJacobian<3>(-S * x.pose.rotation() * so3::Hat(C_mi * g_i), k.params[8],
+                            k.jacobians[8]);
+    benchmark::DoNotOptimize(r);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_AccelMeasurementWithJacobiansFullState);
+
+// The interpolator alone: the full 18×18 Jacobians and the rows each IMU factor reads.
+void BM_InterpolatorState(benchmark::State& state) {
+  Knots k;
+  const gp::GpInterpolator interp(Model(), 0.0, 0.1, 0.043);
+  const gp::KnotState a = gp::ReadKnotState(k.params[0], k.params[1], k.params[2]);
+  const gp::KnotState b = gp::ReadKnotState(k.params[3], k.params[4], k.params[5]);
+  const unsigned masks[] = {gp::kAllStateRows, gp::kRotationRows | gp::kLinearAccelerationRows,
+                            gp::kAngularVelocityRows};
+  const unsigned rows = masks[state.range(0)];
+  gp::KnotState x;
+  gp::StateJacobian J_k, J_k1;
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      interp.State(a, b, &x, &J_k, &J_k1);
+    } else {
+      interp.StateRows(a, b, rows, &x, &J_k, &J_k1);
+    }
+    benchmark::DoNotOptimize(J_k.data());
+    benchmark::DoNotOptimize(J_k1.data());
+    benchmark::ClobberMemory();
+  }
+}
+// 0: State (all rows), 1: StateRows accelerometer rows, 2: StateRows gyro rows.
+BENCHMARK(BM_InterpolatorState)->Arg(0)->Arg(1)->Arg(2);
+
 void BM_AccelMeasurementValueOnly(benchmark::State& state) {
   Knots k;
   const ImuAccelMeasurement cost(Model(), 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 9.8),

@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string>
+#include <type_traits>
 
 namespace ctlio::gp {
 namespace {
@@ -136,6 +137,121 @@ void Evaluate(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>* omega,
   }
 }
 
+// Rows [h, h+N) of layer L (0: δT, 1: ϖ, 2: ϖ̇) of M·[diag(d0); diag(d1); diag(d2)], i.e.
+// Σ_r M_{Lr}[h, h+N)·diag(d_r) with M = [[J, 0, 0], [M21, J, 0], [M31, M32, J]]: the image of a
+// knot variable whose dγ(τ)_r = diag(d_r)·(its contribution), restricted to the wanted rows.
+template <int N>
+Eigen::Matrix<double, N, 6> RowsTimesDiag(const OutputMap& M, int L, int h, const Diag& d0,
+                                          const Diag& d1, const Diag& d2) {
+  Eigen::Matrix<double, N, 6> B;
+  const auto rows = [h](const Mat6& A) { return A.template middleRows<N>(h); };
+  if (L == 0) {
+    B.noalias() = rows(M.J) * d0.matrix().asDiagonal();
+  } else if (L == 1) {
+    B.noalias() = rows(M.M21) * d0.matrix().asDiagonal() + rows(M.J) * d1.matrix().asDiagonal();
+  } else {
+    B.noalias() = rows(M.M31) * d0.matrix().asDiagonal() + rows(M.M32) * d1.matrix().asDiagonal() +
+                  rows(M.J) * d2.matrix().asDiagonal();
+  }
+  return B;
+}
+
+// The row-selective state evaluation (GpInterpolator::StateRows). Per selected row range of
+// layer L, with B_c = Σ_r M_{Lr}·diag(Ω_rc) and dγ_{k+1} from knot_state.h:
+//   ∂/∂δT_{k+1} = (B_0 + B_1·D1 + B_2·D2)·J⁻¹,  ∂/∂ϖ_{k+1} = B_1·J⁻¹ + B_2·E,
+//   ∂/∂ϖ̇_{k+1} = B_2·J⁻¹,  ∂/∂δT_k = −∂/∂δT_{k+1}·Ad21 (+ Ad(Exp ξ) on the pose rows),
+//   ∂/∂ϖ_k = Σ_r M_{Lr}·diag(Λ_r1),  ∂/∂ϖ̇_k = Σ_r M_{Lr}·diag(Λ_r2).
+void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& omega,
+                  const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
+                  StateJacobian* J_k, StateJacobian* J_k1) {
+  const bool jac = (J_k != nullptr || J_k1 != nullptr) && (rows & kAllStateRows) != 0;
+  const LocalVariables lv(k, k1, jac);
+  Vec6 g[3];
+  for (int r = 0; r < 3; ++r) {
+    g[r] = (lambda.block(r, 1) * k.velocity.array() + lambda.block(r, 2) * k.acceleration.array() +
+            omega.block(r, 0) * lv.gamma[0].array() + omega.block(r, 1) * lv.gamma[1].array() +
+            omega.block(r, 2) * lv.gamma[2].array())
+               .matrix();
+  }
+  const Vec6& xi = g[0];
+  const SE3 E = SE3::Exp(xi);
+  OutputMap M;
+  M.J = se3::LeftJacobian(xi);
+  const Vec6 vel = M.J * g[1];
+  const Mat6 Xd = se3::CurlyHat(g[1]);
+  Vec6 v = g[2];
+  v.noalias() += 0.5 * Xd * vel;
+  if (x != nullptr) {
+    x->pose = E * k.pose;
+    x->velocity = vel;
+    x->acceleration.noalias() = M.J * v;
+  }
+  if (!jac) return;
+  const int top_layer = (rows & 48u) != 0 ? 2 : (rows & 12u) != 0 ? 1 : 0;
+  if (top_layer == 1) {
+    M.M21 = LeftJacobianVectorDerivative(xi, g[1]);
+  } else if (top_layer == 2) {
+    const Vec6 w[2] = {g[1], v};
+    Mat6 D[2];
+    LeftJacobianVectorDerivatives<2>(xi, w, D);
+    M.M21 = D[0];
+    // Only the wanted rows of M31 = ∂(Jv)/∂ξ + ½Jξ̇^⋏M21 and M32 = ½J(ξ̇^⋏J − ϖ^⋏) are formed
+    // (RowsTimesDiag reads no others).
+    const Mat6 Xv = se3::CurlyHat(vel);
+    const auto acc_rows = [&](auto n, int h) {
+      constexpr int N = decltype(n)::value;
+      const Eigen::Matrix<double, N, 6> K = M.J.middleRows<N>(h) * Xd;  // rows of J·ξ̇^⋏
+      auto m31 = M.M31.middleRows<N>(h);
+      m31 = D[1].middleRows<N>(h);
+      m31.noalias() += 0.5 * K * M.M21;
+      auto m32 = M.M32.middleRows<N>(h);
+      m32.noalias() = 0.5 * K * M.J;
+      m32.noalias() -= 0.5 * M.J.middleRows<N>(h) * Xv;
+    };
+    const unsigned m = (rows >> 4) & 3u;
+    if (m == 3u) {
+      acc_rows(std::integral_constant<int, 6>(), 0);
+    } else {
+      acc_rows(std::integral_constant<int, 3>(), m == 1u ? 0 : 3);
+    }
+  }
+  const auto range = [&](int L, auto n, int h) {
+    constexpr int N = decltype(n)::value;
+    const int r = 6 * L + h;
+    const auto col = [&](const AxisBlockMatrix<6>& A, int c) {
+      return RowsTimesDiag<N>(M, L, h, A.block(0, c), A.block(1, c), A.block(2, c));
+    };
+    const Eigen::Matrix<double, N, 6> B1 = col(omega, 1), B2 = col(omega, 2);
+    Eigen::Matrix<double, N, 6> S = col(omega, 0);
+    S.noalias() += B1 * lv.D1;
+    S.noalias() += B2 * lv.D2;
+    Eigen::Matrix<double, N, 6> T1;
+    T1.noalias() = S * lv.J_inv;
+    if (J_k1 != nullptr) {
+      J_k1->template block<N, 6>(r, 0) = T1;
+      auto c1 = J_k1->template block<N, 6>(r, 6);
+      c1.noalias() = B1 * lv.J_inv;
+      c1.noalias() += B2 * lv.E;
+      J_k1->template block<N, 6>(r, 12).noalias() = B2 * lv.J_inv;
+    }
+    if (J_k != nullptr) {
+      auto c0 = J_k->template block<N, 6>(r, 0);
+      c0.noalias() = -T1 * lv.Ad21;
+      if (L == 0) c0 += E.Adjoint().template middleRows<N>(h);
+      J_k->template block<N, 6>(r, 6) = col(lambda, 1);
+      J_k->template block<N, 6>(r, 12) = col(lambda, 2);
+    }
+  };
+  for (int L = 0; L <= top_layer; ++L) {
+    const unsigned m = (rows >> (2 * L)) & 3u;
+    if (m == 3u) {
+      range(L, std::integral_constant<int, 6>(), 0);
+    } else if (m != 0u) {
+      range(L, std::integral_constant<int, 3>(), m == 1u ? 0 : 3);
+    }
+  }
+}
+
 [[noreturn]] void Throw(int line, const std::string& what) {
   internal::ThrowInvalid(__FILE__, line, what);
 }
@@ -185,6 +301,11 @@ void GpInterpolator::State(const KnotState& k, const KnotState& k1, KnotState* x
   KnotState tmp;
   KnotState* out = x != nullptr ? x : &tmp;
   Evaluate<18>(lambda_, &omega_, k, &k1, &out->pose, &out->velocity, &out->acceleration, J_k, J_k1);
+}
+
+void GpInterpolator::StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
+                               StateJacobian* J_k, StateJacobian* J_k1) const {
+  EvaluateRows(lambda_, omega_, k, k1, rows, x, J_k, J_k1);
 }
 
 GpExtrapolator::GpExtrapolator(const SingerModel<6>& model, double t_k, double tau) {

@@ -46,12 +46,13 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
   const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const bool need_knots =
-      jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr ||
-                               jacobians[2] != nullptr || jacobians[3] != nullptr ||
-                               jacobians[4] != nullptr || jacobians[5] != nullptr);
+      jacobians != nullptr &&
+      (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr ||
+       jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
   gp::KnotState x;
-  gp::StateJacobian J_k, J_k1;
-  interpolator_.State(k, k1, &x, need_knots ? &J_k : nullptr, need_knots ? &J_k1 : nullptr);
+  gp::StateJacobian J_k, J_k1;  // only the ϖ_ω rows are written and read
+  interpolator_.StateRows(k, k1, gp::kAngularVelocityRows, &x, need_knots ? &J_k : nullptr,
+                          need_knots ? &J_k1 : nullptr);
 
   const Vec3 bg = (1.0 - s_) * b_k.tail<3>() + s_ * b_k1.tail<3>();
   Eigen::Map<Vec3>{residuals} = sqrt_information_ * (gyro_ + x.velocity.tail<3>() - bg);
@@ -73,10 +74,9 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
   return true;
 }
 
-ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k,
-                                         double t_k1, double tau, const Vec3& accel,
-                                         const Mat3& covariance, double gravity,
-                                         AccelModel accel_model)
+ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                                         double tau, const Vec3& accel, const Mat3& covariance,
+                                         double gravity, AccelModel accel_model)
     : interpolator_(model, t_k, t_k1, tau),
       s_(Fraction(t_k, t_k1, tau)),
       accel_(accel),
@@ -94,9 +94,14 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
   if (jacobians != nullptr) {
     for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
   }
+  const bool exact = accel_model_ == AccelModel::kSpecificForce;
+  // Only the rows D reads (below) are written: δφ and ϖ̇_v, and ϖ for the exact model.
+  const unsigned rows = gp::kRotationRows | gp::kLinearAccelerationRows |
+                        (exact ? gp::kLinearVelocityRows | gp::kAngularVelocityRows : 0u);
   gp::KnotState x;
   gp::StateJacobian J_k, J_k1;
-  interpolator_.State(k, k1, &x, need_knots ? &J_k : nullptr, need_knots ? &J_k1 : nullptr);
+  interpolator_.StateRows(k, k1, rows, &x, need_knots ? &J_k : nullptr,
+                          need_knots ? &J_k1 : nullptr);
 
   const Mat3& C = x.pose.rotation();  // C_rm(τ)
   const Vec3 g_m = C_mi * gravity_i_;
@@ -104,7 +109,6 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
   const Vec3 w_v = x.velocity.head<3>(), w_w = x.velocity.tail<3>();
   const Vec3 ba = (1.0 - s_) * b_k.head<3>() + s_ * b_k1.head<3>();
   Vec3 e = accel_ + x.acceleration.head<3>() + g_r - ba;
-  const bool exact = accel_model_ == AccelModel::kSpecificForce;
   if (exact) e -= w_w.cross(w_v);
   Eigen::Map<Vec3>{residuals} = sqrt_information_ * e;
   if (jacobians == nullptr) return true;

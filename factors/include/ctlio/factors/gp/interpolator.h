@@ -24,6 +24,19 @@ namespace ctlio::gp {
 using PoseJacobian = Eigen::Matrix<double, 6, 18>;
 using StateJacobian = Eigen::Matrix<double, 18, 18>;
 
+// Row blocks of a StateJacobian (3 rows each, rows [δρ; δφ; ϖ_v; ϖ_ω; ϖ̇_v; ϖ̇_ω]), combined with
+// |, for GpInterpolator::StateRows: a factor that reads a few components of the state asks for
+// those rows only (gyro: ϖ_ω; accelerometer: δφ, ϖ̇_v and, for the exact specific force, ϖ).
+enum StateRowBlock : unsigned {
+  kTranslationRows = 1u << 0,
+  kRotationRows = 1u << 1,
+  kLinearVelocityRows = 1u << 2,
+  kAngularVelocityRows = 1u << 3,
+  kLinearAccelerationRows = 1u << 4,
+  kAngularAccelerationRows = 1u << 5,
+  kAllStateRows = (1u << 6) - 1,
+};
+
 class GpInterpolator {
  public:
   // Precomputes Λ(τ), Ω(τ). Requires t_k < t_k1 and t_k ≤ tau ≤ t_k1 (throws otherwise).
@@ -35,6 +48,12 @@ class GpInterpolator {
   // T(τ), ϖ(τ), ϖ̇(τ) and the 18×18 Jacobians onto each knot; any output may be null.
   void State(const KnotState& k, const KnotState& k1, KnotState* x, StateJacobian* J_k,
              StateJacobian* J_k1) const;
+  // As State, but only the row blocks selected by `rows` (StateRowBlock flags) of J_k and J_k1
+  // are written; the other rows are left as they were. Same values as the rows of State() up to
+  // rounding (the chain is associated per row, (Σ_c B_c P_c)·J⁻¹ with B_c = M[rows]·Ω_{·c}, so
+  // a 3-row request costs a fraction of the 18×18 product), checked in interpolator_test.
+  void StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
+                 StateJacobian* J_k, StateJacobian* J_k1) const;
 
   const AxisBlockMatrix<6>& Lambda() const { return lambda_; }
   const AxisBlockMatrix<6>& Omega() const { return omega_; }
