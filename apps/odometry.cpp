@@ -120,8 +120,12 @@ int main(int argc, char** argv) {
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
          << "\nfailed_scans " << run.failed << "\ndegenerate_scans " << run.degenerate
          << "\nimu_gap_scans " << run.imu_gaps << "\nmedian_ms " << run.median_ms << "\np95_ms "
-         << run.p95_ms << "\nmax_ms " << run.max_ms << "\npeak_rss_mb " << run.peak_rss_kb / 1024.0
-         << "\n";
+         << run.p95_ms << "\nmax_ms " << run.max_ms << "\nmedian_cpu_ms " << run.median_cpu_ms
+         << "\np95_cpu_ms " << run.p95_cpu_ms << "\nmedian_preprocess_ms "
+         << run.median_preprocess_ms << "\nmedian_associate_ms " << run.median_associate_ms
+         << "\nmedian_solve_ms " << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
+         << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
+         << run.peak_rss_kb / 1024.0 << "\n";
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
@@ -135,8 +139,8 @@ int main(int argc, char** argv) {
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       runs.push_back(std::move(run));
     }
-    std::printf("\n%-12s %8s %8s %8s %6s %6s %9s %9s %9s\n", "method", "ATE[m]", "mean[m]",
-                "max[m]", "failed", "degen", "med[ms]", "p95[ms]", "peakMB");
+    std::printf("\n%-12s %8s %8s %8s %6s %6s %9s %9s %9s %9s %9s\n", "method", "ATE[m]", "mean[m]",
+                "max[m]", "failed", "degen", "med[ms]", "p95[ms]", "cpu_med", "cpu_p95", "peakMB");
     for (const auto& r : runs) {
       if (r.ate) {
         std::printf("%-12s %8.4f %8.4f %8.4f", r.method.c_str(), r.ate->rmse, r.ate->mean,
@@ -144,8 +148,13 @@ int main(int argc, char** argv) {
       } else {
         std::printf("%-12s %8s %8s %8s", r.method.c_str(), "-", "-", "-");
       }
-      std::printf(" %6d %6d %9.1f %9.1f %9.1f\n", r.failed, r.degenerate, r.median_ms, r.p95_ms,
-                  r.peak_rss_kb / 1024.0);
+      std::printf(" %6d %6d %9.1f %9.1f %9.1f %9.1f %9.1f\n", r.failed, r.degenerate, r.median_ms,
+                  r.p95_ms, r.median_cpu_ms, r.p95_cpu_ms, r.peak_rss_kb / 1024.0);
+      std::printf(
+          "  %-10s wall-time split, median ms: preprocess %.1f  associate %.1f  solve %.1f"
+          "  map %.1f  marginalise %.1f\n",
+          r.method.c_str(), r.median_preprocess_ms, r.median_associate_ms, r.median_solve_ms,
+          r.median_map_ms, r.median_marginalize_ms);
     }
     int bad = 0;
     for (const auto& r : runs) bad += r.failure ? 1 : 0;

@@ -1,5 +1,7 @@
 #include "run_odometry.h"
 
+#include <sys/resource.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -12,13 +14,11 @@
 
 namespace ctlio::lioapp {
 
+// Process-wide high-water mark of the resident set (getrusage ru_maxrss, kB on Linux).
 long PeakRssKb() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return 0;
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return usage.ru_maxrss;
 }
 
 double Percentile(std::vector<double> v, double p) {
@@ -137,6 +137,25 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   run.median_ms = Percentile(reg, 0.5);
   run.p95_ms = Percentile(reg, 0.95);
   run.max_ms = reg.empty() ? 0.0 : *std::max_element(reg.begin(), reg.end());
+  {
+    std::vector<double> cpu, pre, assoc, solve, map, marg;
+    for (size_t i = 1; i < run.scans.size(); ++i) {
+      const lio::ScanResult& r = run.scans[i];
+      cpu.push_back(r.cpu_ms);
+      pre.push_back(r.ms_preprocess);
+      assoc.push_back(r.ms_associate);
+      solve.push_back(r.ms_solve);
+      map.push_back(r.ms_map);
+      marg.push_back(r.ms_marginalize);
+    }
+    run.median_cpu_ms = Percentile(cpu, 0.5);
+    run.p95_cpu_ms = Percentile(cpu, 0.95);
+    run.median_preprocess_ms = Percentile(pre, 0.5);
+    run.median_associate_ms = Percentile(assoc, 0.5);
+    run.median_solve_ms = Percentile(solve, 0.5);
+    run.median_map_ms = Percentile(map, 0.5);
+    run.median_marginalize_ms = Percentile(marg, 0.5);
+  }
   run.peak_rss_kb = PeakRssKb();
   if (const auto truth = source.GroundTruth()) {
     run.ate = EvaluateAte(run.trajectory, *truth);
@@ -191,15 +210,16 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write the scan log");
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
-       "ms ms_preprocess ms_associate ms_solve ms_map x y z message\n";
+       "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z message\n";
   f << std::setprecision(12);
   for (const lio::ScanResult& r : run.scans) {
     const Vec3 p = r.T_mr.translation();
     f << 1e-9 * double(r.t_ns) << ' ' << lio::ScanStatusName(r.status) << ' ' << r.keypoints << ' '
       << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds << ' ' << r.solver_iterations
       << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << r.ms_preprocess << ' '
-      << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << p.x() << ' ' << p.y()
-      << ' ' << p.z() << ' ' << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+      << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << r.ms_marginalize << ' '
+      << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
+      << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
 }
 

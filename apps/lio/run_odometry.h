@@ -37,9 +37,13 @@ struct RunSummary {
   std::vector<io::StampedPose> trajectory;
   std::vector<lio::ScanResult> scans;
   int failed = 0, degenerate = 0, imu_gaps = 0;
-  std::string first_failure;  // message of the first failed scan
-  double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;
-  long peak_rss_kb = 0;          // process-wide high-water mark (VmHWM) at the end of the run
+  std::string first_failure;                           // message of the first failed scan
+  double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
+  double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan
+  // Medians over the scans of the wall-time split (ScanResult::ms_*).
+  double median_preprocess_ms = 0.0, median_associate_ms = 0.0, median_solve_ms = 0.0,
+         median_map_ms = 0.0, median_marginalize_ms = 0.0;
+  long peak_rss_kb = 0;          // process-wide high-water mark (getrusage ru_maxrss) at the end
   std::optional<AteResult> ate;  // when the source has ground truth
   // The run is a failure if a scan failed after initialisation or the ATE exceeds
   // `failure_ate` (the estimate left the room of any sensible error).

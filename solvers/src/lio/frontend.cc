@@ -145,7 +145,15 @@ std::vector<TimedPoint> LidarFrontend::Preprocess(const std::vector<TimedPoint>&
 
 std::vector<TimedPoint> LidarFrontend::Keypoints(
     const std::vector<TimedPoint>& preprocessed) const {
-  return VoxelGridSubsample(preprocessed, options_.keypoint_voxel_size);
+  std::vector<TimedPoint> keypoints =
+      VoxelGridSubsample(preprocessed, options_.keypoint_voxel_size);
+  const size_t cap = static_cast<size_t>(options_.max_keypoints);
+  if (cap == 0 || keypoints.size() <= cap) return keypoints;
+  // Evenly spaced subset: index i·n/cap, i = 0..cap−1 (deterministic, keeps the firing order).
+  std::vector<TimedPoint> kept;
+  kept.reserve(cap);
+  for (size_t i = 0; i < cap; ++i) kept.push_back(keypoints[i * keypoints.size() / cap]);
+  return kept;
 }
 
 void LidarFrontend::UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map) {

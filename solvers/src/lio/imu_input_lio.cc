@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
+#include "ctlio/factors/priors/euclidean_prior.h"
 #include "ctlio/solvers/lio/lio_residuals.h"
 
 namespace ctlio::lio {
@@ -26,18 +27,21 @@ SE3 ImuInputLio::DeskewTable::Interpolate(double tau) const {
   return SE3::Exp(s * xi) * T_wb[i];
 }
 
-ImuInputLio::ImuInputLio(const OdometryConfig& config)
-    : LioOdometry(config),
-      problem_([] {
-        ceres::Problem::Options o;
-        o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        o.enable_fast_removal = true;
-        return o;
-      }()),
-      lidar_loss_(MakeLidarLoss(config)) {}
+ImuInputLio::ImuInputLio(const OdometryConfig& config) : LioOdometry(config) {}
 
 ImuInputLio::~ImuInputLio() = default;
+
+ImuInputLio::State ImuInputLio::AddState(double t, int64_t t_ns, const SE3& T_wb, const Vec3& v,
+                                         const Vec6& bias) {
+  State s;
+  s.t = t;
+  s.t_ns = t_ns;
+  s.id = 8 * next_state_++;
+  s.pose = window_.AddPoseState(s.id, T_wb);
+  s.velocity = window_.AddVectorState(s.id + 1, v);
+  s.bias = window_.AddVectorState(s.id + 3, bias);
+  return s;
+}
 
 ImuInputLio::DeskewTable ImuInputLio::Integrate(const State& from, double t_end) const {
   DeskewTable table;
@@ -74,33 +78,32 @@ void ImuInputLio::Fill(const State& s, ScanStatus status, ScanResult* result) co
 
 void ImuInputLio::Initialise(const PreparedScan& scan, ScanResult* result) {
   // The platform is still at start (gravity initialisation checked it): the first state is the
-  // map origin at rest, held constant, which also fixes the gauge.
-  auto s = std::make_unique<State>();
-  s->t = scan.t_end;
-  s->t_ns = scan.end_ns;
-  problem_.AddParameterBlock(s->pose, 7, &pose_manifold_);
-  problem_.AddParameterBlock(s->velocity, 3);
-  problem_.AddParameterBlock(s->bias, 6);
-  problem_.SetParameterBlockConstant(s->pose);
-  problem_.SetParameterBlockConstant(s->velocity);
-  problem_.SetParameterBlockConstant(s->bias);
+  // map origin at rest, held constant (which fixes the gauge); its biases are free under the
+  // initial bias prior, as in Singer-LIO.
+  states_.push_back(AddState(scan.t_end, scan.end_ns, SE3(), Vec3::Zero(), Vec6::Zero()));
+  const State& s = states_.back();
+  window_.SetStateConstant(s.id, true);
+  window_.SetStateConstant(s.id + 1, true);
+  Vec6 variance;
+  variance << Vec3::Constant(config_.initial_bias_accel_variance),
+      Vec3::Constant(config_.initial_bias_gyro_variance);
+  window_.AddResidualBlock(
+      EuclideanPrior<6>::FromCovariance(Vec6::Zero(), variance.asDiagonal().toDenseMatrix()),
+      nullptr, {s.id + 3});
   std::vector<Vec3> map_points;
   map_points.reserve(scan.points.size());
   for (const TimedPoint& p : scan.points) map_points.push_back(p.point);
   frontend_.UpdateMap(map_points, Vec3::Zero());
-  Fill(*s, ScanStatus::kOk, result);
-  states_.push_back(std::move(s));
+  Fill(s, ScanStatus::kOk, result);
 }
 
 void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
-  State& prev = *states_.back();
-  auto owned = std::make_unique<State>();
-  State& s = *owned;
-  s.t = scan.t_end;
-  s.t_ns = scan.end_ns;
+  Slide(result);
+  const State prev = states_.back();
+  const double t_s = scan.t_end;
 
   double max_gap = 0.0;
-  const std::vector<ImuSegment> segments = ImuSegments(prev.t, s.t, &max_gap);
+  const std::vector<ImuSegment> segments = ImuSegments(prev.t, t_s, &max_gap);
   if (segments.empty()) throw std::runtime_error("no IMU samples for this scan");
   if (max_gap > config_.max_imu_gap) {
     std::ostringstream m;
@@ -125,31 +128,17 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
   start.p = T_prev.translation();
   start.v = Eigen::Map<const Vec3>(prev.velocity);
   const imu::NavState pred = pim.Predict(start, bias_hat, gravity_map());
-  PoseManifold::Store(SE3(pred.C, pred.p), s.pose);
-  Eigen::Map<Vec3>(s.velocity) = pred.v;
-  std::copy(prev.bias, prev.bias + 6, s.bias);
-
-  problem_.AddParameterBlock(s.pose, 7, &pose_manifold_);
-  problem_.AddParameterBlock(s.velocity, 3);
-  problem_.AddParameterBlock(s.bias, 6);
-  problem_.AddResidualBlock(new imu::PreintegratedImuFactor(pim, gravity_map()), nullptr, prev.pose,
-                            prev.velocity, prev.bias, s.pose, s.velocity);
-  problem_.AddResidualBlock(MakeBiasRandomWalk(config_, s.t - prev.t), nullptr, prev.bias, s.bias);
+  states_.push_back(AddState(t_s, scan.end_ns, SE3(pred.C, pred.p), pred.v, bias_hat));
+  const State& s = states_.back();
+  window_.AddResidualBlock(new imu::PreintegratedImuFactor(pim, gravity_map()), nullptr,
+                           {prev.id, prev.id + 1, prev.id + 3, s.id, s.id + 1});
+  window_.AddResidualBlock(MakeBiasRandomWalk(config_, s.t - prev.t), nullptr,
+                           {prev.id + 3, s.id + 3});
   result->imu_residuals = 1;
 
-  ceres::Solver::Options options = WindowSolverOptions(config_);
-  std::vector<ceres::ResidualBlockId> lidar_blocks;
   PlaneAssociator associator(frontend_.map(), config_.frontend);
-  SE3 last_pose = PoseManifold::Pose(s.pose);
-  bool degenerate = false;
-  using Clock = std::chrono::steady_clock;
-  const auto ms_since = [](Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  };
-  for (int round = 0; round < config_.frontend.max_iterations; ++round) {
-    auto t0 = Clock::now();
-    for (ceres::ResidualBlockId id : lidar_blocks) problem_.RemoveResidualBlock(id);
-    lidar_blocks.clear();
+  const auto add_lidar = [&](ceres::LossFunction* loss,
+                             std::vector<ceres::ResidualBlockId>* blocks) {
     // Deskew with the current estimate: every point moved into the body frame at the scan end
     // by the IMU-integrated motion.
     const DeskewTable table = Integrate(prev, s.t);
@@ -160,43 +149,15 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
       PlaneAssociation a;
       if (!associator.Associate(q, T_wb * q, &a)) continue;
       a.weight /= config_.frontend.point_noise_sigma;
-      lidar_blocks.push_back(
-          problem_.AddResidualBlock(new PointToPlaneWorld(a), lidar_loss_.get(), s.pose));
+      blocks->push_back(window_.AddResidualBlock(new PointToPlaneWorld(a), loss, {s.id}));
     }
-    result->associations = static_cast<int>(lidar_blocks.size());
-    if (static_cast<int>(lidar_blocks.size()) < config_.min_associations) {
-      for (ceres::ResidualBlockId id : lidar_blocks) problem_.RemoveResidualBlock(id);
-      lidar_blocks.clear();
-      degenerate = true;
-    }
-    result->ms_associate += ms_since(t0);
-    t0 = Clock::now();
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem_, &summary);
-    result->ms_solve += ms_since(t0);
-    result->rounds = round + 1;
-    result->solver_iterations += static_cast<int>(summary.iterations.size());
-    result->final_cost = summary.final_cost;
-    const SE3 T_new = PoseManifold::Pose(s.pose);
-    const Vec6 step = (T_new * last_pose.Inverse()).Log();
-    last_pose = T_new;
-    if (degenerate || (step.head<3>().norm() < config_.frontend.convergence_translation &&
-                       step.tail<3>().norm() < config_.frontend.convergence_rotation)) {
-      break;
-    }
-  }
+  };
+  const bool degenerate = SolveRounds(
+      add_lidar, [&s] { return PoseManifold::Pose(s.pose); }, result);
 
   // Map update with every preprocessed point, deskewed by the final estimate.
-  const auto t_map = Clock::now();
-  const DeskewTable table = Integrate(prev, s.t);
-  const SE3 T_end_inv = table.T_wb.back().Inverse();
+  const auto t_map = std::chrono::steady_clock::now();
   const SE3 T_wb = PoseManifold::Pose(s.pose);
-  std::vector<Vec3> map_points;
-  map_points.reserve(scan.points.size());
-  for (const TimedPoint& p : scan.points) {
-    map_points.push_back(T_wb * (T_end_inv * (table.Interpolate(p.time) * p.point)));
-  }
-
   const double jump = (T_wb.translation() - T_prev.translation()).norm();
   if (!T_wb.translation().allFinite() || jump > config_.max_scan_translation) {
     // Do not pollute the map with a diverged pose; report it.
@@ -206,35 +167,28 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
     result->status = ScanStatus::kFailed;
     result->message = m.str();
   } else {
+    const DeskewTable table = Integrate(prev, s.t);
+    const SE3 T_end_inv = table.T_wb.back().Inverse();
+    std::vector<Vec3> map_points;
+    map_points.reserve(scan.points.size());
+    for (const TimedPoint& p : scan.points) {
+      map_points.push_back(T_wb * (T_end_inv * (table.Interpolate(p.time) * p.point)));
+    }
     frontend_.UpdateMap(map_points, T_wb.translation());
   }
-  if (degenerate && result->status == ScanStatus::kOk) {
-    result->status = ScanStatus::kDegenerate;
-    result->message = "only " + std::to_string(result->associations) +
-                      " plane associations (need " + std::to_string(config_.min_associations) +
-                      "): lidar term dropped for this scan";
-  }
-  result->ms_map = ms_since(t_map);
+  if (degenerate) ReportDegenerate(result);
+  result->ms_map =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_map).count();
   Fill(s, ScanStatus::kOk, result);
-  states_.push_back(std::move(owned));
-  Slide();
 }
 
-// Window (SPEC §4): the `window_knots` newest states are free, the one before is held
-// constant; anything older only touches held or removed states, so removing it changes
-// nothing in the free states' solution (see SingerLio::Slide for the argument).
-void ImuInputLio::Slide() {
-  const int free_states = static_cast<int>(states_.size()) - 1;
-  if (free_states <= config_.window_knots) return;
-  State& hold = *states_[1];
-  problem_.SetParameterBlockConstant(hold.pose);
-  problem_.SetParameterBlockConstant(hold.velocity);
-  problem_.SetParameterBlockConstant(hold.bias);
-  State& old = *states_.front();
-  problem_.RemoveParameterBlock(old.pose);
-  problem_.RemoveParameterBlock(old.velocity);
-  problem_.RemoveParameterBlock(old.bias);
-  states_.pop_front();
+// Window (SPEC §4, §5), as in SingerLio::Slide: the oldest states are marginalised by Schur
+// complement into one prior until window_knots − 1 remain, before the new state is added.
+void ImuInputLio::Slide(ScanResult* result) {
+  while (static_cast<int>(states_.size()) > config_.window_knots - 1) {
+    MarginalizeStates(states_.front().ids(), result);
+    states_.pop_front();
+  }
 }
 
 }  // namespace ctlio::lio

@@ -20,6 +20,7 @@ void LidarFrontendOptions::Validate() const {
   require(voxel_size > 0.0 && initial_voxel_size > 0.0, "voxel sizes must be positive");
   require(initial_scans >= 0, "initial_scans must be >= 0");
   require(keypoint_voxel_size > 0.0, "keypoint_voxel_size must be positive");
+  require(max_keypoints >= 0, "max_keypoints must be >= 0 (0 = no cap)");
   require(map_voxel_size > 0.0, "map_voxel_size must be positive");
   require(max_points_per_voxel >= 1, "max_points_per_voxel must be >= 1");
   require(min_point_distance >= 0.0, "min_point_distance must be >= 0");
@@ -51,6 +52,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
       {"initial_voxel_size", SetFromYaml(&o.initial_voxel_size)},
       {"initial_scans", SetFromYaml(&o.initial_scans)},
       {"keypoint_voxel_size", SetFromYaml(&o.keypoint_voxel_size)},
+      {"max_keypoints", SetFromYaml(&o.max_keypoints)},
       {"map_voxel_size", SetFromYaml(&o.map_voxel_size)},
       {"max_points_per_voxel", SetFromYaml(&o.max_points_per_voxel)},
       {"min_point_distance", SetFromYaml(&o.min_point_distance)},

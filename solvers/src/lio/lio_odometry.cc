@@ -3,18 +3,89 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <sstream>
 #include <stdexcept>
 
 #include "ctlio/factors/imu/gravity_initialization.h"
 #include "ctlio/solvers/lio/imu_input_lio.h"
+#include "ctlio/solvers/lio/lio_residuals.h"
 #include "ctlio/solvers/lio/singer_lio.h"
 
 namespace ctlio::lio {
 
+namespace {
+SlidingWindowOptions WindowOptions(const OdometryConfig& config) {
+  SlidingWindowOptions o;
+  o.solver = WindowSolverOptions(config);
+  return o;
+}
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
 LioOdometry::LioOdometry(const OdometryConfig& config)
-    : frontend_(config.frontend), config_(config) {
+    : frontend_(config.frontend), config_(config), window_(WindowOptions(config)) {
   config_.Validate();
+}
+
+ceres::LossFunction* LioOdometry::NewLidarLoss() const { return MakeLidarLoss(config_).release(); }
+
+bool LioOdometry::SolveRounds(const AddLidarResiduals& add_lidar,
+                              const std::function<SE3()>& newest_pose, ScanResult* result) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<ceres::ResidualBlockId> lidar_blocks;
+  SE3 last_pose = newest_pose();
+  bool degenerate = false;
+  for (int round = 0; round < config_.frontend.max_iterations; ++round) {
+    auto t0 = Clock::now();
+    for (ceres::ResidualBlockId id : lidar_blocks) window_.RemoveResidualBlock(id);
+    lidar_blocks.clear();
+    // One loss object per round, shared by its residuals: the window owns (and ref-counts) it.
+    std::unique_ptr<ceres::LossFunction> loss(NewLidarLoss());
+    add_lidar(loss.get(), &lidar_blocks);
+    // Once a residual used it, Ceres owns the loss (and deletes it with the last such residual,
+    // possibly right below).
+    if (!lidar_blocks.empty()) loss.release();
+    result->associations = static_cast<int>(lidar_blocks.size());
+    if (static_cast<int>(lidar_blocks.size()) < config_.min_associations) {
+      for (ceres::ResidualBlockId id : lidar_blocks) window_.RemoveResidualBlock(id);
+      lidar_blocks.clear();
+      degenerate = true;
+    }
+    result->ms_associate += MsSince(t0);
+    t0 = Clock::now();
+    const ceres::Solver::Summary summary = window_.Solve();
+    result->ms_solve += MsSince(t0);
+    result->rounds = round + 1;
+    result->solver_iterations += static_cast<int>(summary.iterations.size());
+    result->final_cost = summary.final_cost;
+    const SE3 T_new = newest_pose();
+    const Vec6 step = (T_new * last_pose.Inverse()).Log();
+    last_pose = T_new;
+    if (degenerate || (step.head<3>().norm() < config_.frontend.convergence_translation &&
+                       step.tail<3>().norm() < config_.frontend.convergence_rotation)) {
+      break;
+    }
+  }
+  return degenerate;
+}
+
+void LioOdometry::MarginalizeStates(const std::vector<StateId>& ids, ScanResult* result) {
+  const auto t0 = std::chrono::steady_clock::now();
+  last_marginalization_ = window_.Marginalize(ids);
+  ++num_marginalizations_;
+  result->ms_marginalize += MsSince(t0);
+}
+
+void LioOdometry::ReportDegenerate(ScanResult* result) const {
+  if (result->status != ScanStatus::kOk) return;
+  result->status = ScanStatus::kDegenerate;
+  result->message = "only " + std::to_string(result->associations) + " plane associations (need " +
+                    std::to_string(config_.min_associations) +
+                    "): lidar term dropped for this scan, the prior" +
+                    (uses_imu() ? " and the IMU carry" : " carries") + " the state";
 }
 
 void LioOdometry::AddImu(const ImuSample& s) {
@@ -123,8 +194,17 @@ bool LioOdometry::InitialiseGravity(double t_end, std::string* message) {
   return true;
 }
 
+namespace {
+double ThreadCpuMs() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+}  // namespace
+
 ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuMs();
   if (scan.points.size() != scan.times_ns.size()) {
     throw std::invalid_argument("LioOdometry::AddScan: scan ending at " +
                                 std::to_string(scan.end_ns) + " ns has " +
@@ -196,6 +276,7 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   TrimImu(Seconds(last_scan_end_ns_) - 0.5);
   result.milliseconds =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.cpu_ms = ThreadCpuMs() - cpu_start;
   results_.push_back(result);
   return result;
 }

@@ -16,7 +16,7 @@ std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const OdometryConfig& config)
 
 ceres::Solver::Options WindowSolverOptions(const OdometryConfig& config) {
   ceres::Solver::Options o;
-  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  o.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   o.max_num_iterations = config.frontend.solver_iterations;
   o.num_threads = config.solver_threads;
   o.minimizer_progress_to_stdout = false;

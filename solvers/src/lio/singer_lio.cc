@@ -14,6 +14,8 @@
 #include "ctlio/factors/imu/bias_factors.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/factors/priors/euclidean_prior.h"
+#include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/lio_residuals.h"
 
 namespace ctlio::lio {
@@ -24,33 +26,27 @@ struct SingerLio::Impl {
 };
 
 SingerLio::SingerLio(const OdometryConfig& config)
-    : LioOdometry(config),
-      problem_([] {
-        ceres::Problem::Options o;
-        o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-        o.enable_fast_removal = true;
-        return o;
-      }()),
-      lidar_loss_(MakeLidarLoss(config)),
-      accel_loss_(config.accel_loss_scale > 0 ? new ceres::CauchyLoss(config.accel_loss_scale)
-                                              : nullptr),
-      impl_(std::make_unique<Impl>(config)) {}
+    : LioOdometry(config), impl_(std::make_unique<Impl>(config)) {}
 
 SingerLio::~SingerLio() = default;
 
-void SingerLio::AddKnotBlocks(Knot* k) {
-  problem_.AddParameterBlock(k->pose, 7, &pose_manifold_);
-  problem_.AddParameterBlock(k->velocity, 6);
-  problem_.AddParameterBlock(k->acceleration, 6);
-  if (uses_imu()) problem_.AddParameterBlock(k->bias, 6);
+std::vector<StateId> SingerLio::Knot::ids() const {
+  std::vector<StateId> out = {id, id + 1, id + 2};
+  if (bias != nullptr) out.push_back(id + 3);
+  return out;
 }
 
-void SingerLio::SetKnotConstant(Knot* k) {
-  problem_.SetParameterBlockConstant(k->pose);
-  problem_.SetParameterBlockConstant(k->velocity);
-  problem_.SetParameterBlockConstant(k->acceleration);
-  if (uses_imu()) problem_.SetParameterBlockConstant(k->bias);
+SingerLio::Knot SingerLio::AddKnot(double t, int64_t t_ns, const SE3& T_rm, const Vec6& w,
+                                   const Vec6& dw, const Vec6& bias) {
+  Knot k;
+  k.t = t;
+  k.t_ns = t_ns;
+  k.id = 8 * next_knot_++;
+  k.pose = window_.AddPoseState(k.id, T_rm);
+  k.velocity = window_.AddVectorState(k.id + 1, w);
+  k.acceleration = window_.AddVectorState(k.id + 2, dw);
+  if (uses_imu()) k.bias = window_.AddVectorState(k.id + 3, bias);
+  return k;
 }
 
 SE3 SingerLio::PoseAt(const Knot& a, const Knot& b, double tau) const {
@@ -65,48 +61,48 @@ void SingerLio::Fill(const Knot& k, ScanResult* result) const {
   result->T_mr = PoseManifold::Pose(k.pose).Inverse();
   // ϖ is minus the body twist [v; ω] in the robot frame (SPEC §1).
   result->velocity = -Eigen::Map<const Vec6>(k.velocity);
-  result->bias = Eigen::Map<const Vec6>(k.bias);
+  result->bias = k.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(k.bias)) : Vec6::Zero();
 }
 
 void SingerLio::Initialise(const PreparedScan& scan, ScanResult* result) {
-  // Still at start (checked by the gravity initialisation): knot 0 is the map origin at rest,
-  // held constant, which fixes the gauge; its biases start at zero (their prior mean).
-  Eigen::Quaterniond q(C_mi_);
-  C_mi_block_[0] = q.x();
-  C_mi_block_[1] = q.y();
-  C_mi_block_[2] = q.z();
-  C_mi_block_[3] = q.w();
+  // Still at start (checked by the gravity initialisation): knot 0 is the map origin at rest.
+  // Its pose, ϖ and ϖ̇ are held constant, which fixes the gauge; its biases are free under the
+  // initial bias prior (zero mean, config variances), so the marginal priors carry them on.
   if (config_.method == LioMethod::kSingerLio) {
-    problem_.AddParameterBlock(C_mi_block_, 4, &rotation_manifold_);
-    if (!config_.estimate_gravity) problem_.SetParameterBlockConstant(C_mi_block_);
+    C_mi_block_ = window_.AddRotationState(kGravityId, C_mi_);
+    if (!config_.estimate_gravity) window_.SetStateConstant(kGravityId, true);
   }
-  auto k = std::make_unique<Knot>();
-  k->t = scan.t_end;
-  k->t_ns = scan.end_ns;
-  AddKnotBlocks(k.get());
-  SetKnotConstant(k.get());
+  knots_.push_back(
+      AddKnot(scan.t_end, scan.end_ns, SE3(), Vec6::Zero(), Vec6::Zero(), Vec6::Zero()));
+  const Knot& k = knots_.back();
+  for (int i = 0; i < 3; ++i) window_.SetStateConstant(k.id + i, true);
+  if (uses_imu()) {
+    Vec6 variance;
+    variance << Vec3::Constant(config_.initial_bias_accel_variance),
+        Vec3::Constant(config_.initial_bias_gyro_variance);
+    window_.AddResidualBlock(
+        EuclideanPrior<6>::FromCovariance(Vec6::Zero(), variance.asDiagonal().toDenseMatrix()),
+        nullptr, {k.id + 3});
+  }
   std::vector<Vec3> map_points;
   map_points.reserve(scan.points.size());
   for (const TimedPoint& p : scan.points) map_points.push_back(p.point);
   frontend_.UpdateMap(map_points, Vec3::Zero());
-  Fill(*k, result);
-  knots_.push_back(std::move(k));
+  Fill(k, result);
 }
 
 void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
-  Knot& prev = *knots_.back();
-  auto owned = std::make_unique<Knot>();
-  Knot& k = *owned;
-  k.t = scan.t_end;
-  k.t_ns = scan.end_ns;
-  const double dt = k.t - prev.t;
+  Slide(result);
+  const Knot prev = knots_.back();
+  const double t_k = scan.t_end;
+  const double dt = t_k - prev.t;
 
   // IMU over the interval: gap check and the samples to use as measurements.
   std::vector<ImuSample> imu;
   if (uses_imu()) {
     double max_gap = 0.0;
-    ImuSegments(prev.t, k.t, &max_gap);
-    imu = ImuSamples(prev.t, k.t);
+    ImuSegments(prev.t, t_k, &max_gap);
+    imu = ImuSamples(prev.t, t_k);
     if (max_gap > config_.max_imu_gap) {
       std::ostringstream m;
       m << "IMU gap of " << max_gap << " s (limit " << config_.max_imu_gap
@@ -122,101 +118,89 @@ void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
   if (uses_imu() && !imu.empty()) {
     w.tail<3>() = -(imu.back().gyro - Eigen::Map<const Vec3>(prev.bias + 3));
   }
-  PoseManifold::Store(SE3::Exp(dt * w) * PoseManifold::Pose(prev.pose), k.pose);
-  Eigen::Map<Vec6>(k.velocity) = w;
-  Eigen::Map<Vec6>(k.acceleration).setZero();
-  std::copy(prev.bias, prev.bias + 6, k.bias);
-  AddKnotBlocks(&k);
+  const Vec6 bias = prev.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(prev.bias)) : Vec6::Zero();
+  knots_.push_back(AddKnot(t_k, scan.end_ns, SE3::Exp(dt * w) * PoseManifold::Pose(prev.pose), w,
+                           Vec6::Zero(), bias));
+  const Knot& k = knots_.back();
+  const std::vector<StateId> gp_states = {prev.id, prev.id + 1, prev.id + 2,
+                                          k.id,    k.id + 1,    k.id + 2};
 
   // GP prior between the knots (SPEC §2).
-  problem_.AddResidualBlock(new gp::SingerPrior(impl_->model, dt), nullptr, prev.pose,
-                            prev.velocity, prev.acceleration, k.pose, k.velocity, k.acceleration);
+  window_.AddResidualBlock(new gp::SingerPrior(impl_->model, dt), nullptr, gp_states);
   // IMU as a measurement of the interpolated state (SPEC §3).
   if (uses_imu()) {
-    problem_.AddResidualBlock(MakeBiasRandomWalk(config_, dt), nullptr, prev.bias, k.bias);
+    window_.AddResidualBlock(MakeBiasRandomWalk(config_, dt), nullptr, {prev.id + 3, k.id + 3});
     const Mat3 gyro_cov = config_.gyro_variance * Mat3::Identity();
     const Mat3 accel_cov = config_.accel_variance * Mat3::Identity();
     const imu::AccelModel accel_model = config_.exact_specific_force
                                             ? imu::AccelModel::kSpecificForce
                                             : imu::AccelModel::kBodyCentric;
+    std::vector<StateId> gyro_states = gp_states;
+    gyro_states.push_back(prev.id + 3);
+    gyro_states.push_back(k.id + 3);
+    std::vector<StateId> accel_states = gyro_states;
+    accel_states.push_back(kGravityId);
+    // One loss per scan, shared by its accelerometer residuals (the window ref-counts it).
+    std::unique_ptr<ceres::LossFunction> accel_loss(
+        config_.accel_loss_scale > 0 ? new ceres::CauchyLoss(config_.accel_loss_scale) : nullptr);
+    bool accel_loss_used = false;
     for (const ImuSample& s : imu) {
       const double tau = Seconds(s.t_ns);
-      problem_.AddResidualBlock(
+      window_.AddResidualBlock(
           new imu::ImuGyroMeasurement(impl_->model, prev.t, k.t, tau, s.gyro, gyro_cov), nullptr,
-          prev.pose, prev.velocity, prev.acceleration, k.pose, k.velocity, k.acceleration,
-          prev.bias, k.bias);
+          gyro_states);
       ++result->imu_residuals;
       if (config_.method == LioMethod::kSingerLio) {
-        problem_.AddResidualBlock(
+        window_.AddResidualBlock(
             new imu::ImuAccelMeasurement(impl_->model, prev.t, k.t, tau, s.accel, accel_cov,
                                          config_.gravity, accel_model),
-            accel_loss_.get(), prev.pose, prev.velocity, prev.acceleration, k.pose, k.velocity,
-            k.acceleration, prev.bias, k.bias, C_mi_block_);
+            accel_loss.get(), accel_states);
+        accel_loss_used = accel_loss != nullptr;
         ++result->imu_residuals;
       }
     }
+    if (accel_loss_used) accel_loss.release();
   }
 
-  // Lidar: interpolated point-to-plane, re-associated every round (SPEC §4).
-  const ceres::Solver::Options options = WindowSolverOptions(config_);
-  std::vector<ceres::ResidualBlockId> lidar_blocks;
+  // Lidar: interpolated point-to-plane, re-associated every round (SPEC §4). The interpolation
+  // (its Φ, Q blocks depend on the times only) is built once per distinct point time (a lidar
+  // firing) and shared by that firing's residuals and by every round.
+  std::vector<std::shared_ptr<const SharedInterpolatedPose>> interpolation(scan.keypoints.size());
+  for (size_t i = 0; i < scan.keypoints.size(); ++i) {
+    const double tau = std::clamp(scan.keypoints[i].time, prev.t, k.t);
+    if (i > 0 && scan.keypoints[i].time == scan.keypoints[i - 1].time) {
+      interpolation[i] = interpolation[i - 1];
+    } else {
+      interpolation[i] =
+          std::make_shared<const SharedInterpolatedPose>(impl_->model, prev.t, k.t, tau);
+    }
+  }
   PlaneAssociator associator(frontend_.map(), config_.frontend);
-  SE3 last_pose = PoseManifold::Pose(k.pose);
-  bool degenerate = false;
-  using Clock = std::chrono::steady_clock;
-  const auto ms_since = [](Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  };
-  for (int round = 0; round < config_.frontend.max_iterations; ++round) {
-    auto t0 = Clock::now();
-    for (ceres::ResidualBlockId id : lidar_blocks) problem_.RemoveResidualBlock(id);
-    lidar_blocks.clear();
-    // One shared interpolation per distinct point time (a lidar firing), see lio_residuals.h.
-    std::shared_ptr<const SharedInterpolatedPose> shared;
-    double shared_tau = -1.0;
+  const auto add_lidar = [&](ceres::LossFunction* loss,
+                             std::vector<ceres::ResidualBlockId>* blocks) {
+    const double* knot_blocks[6] = {prev.pose, prev.velocity, prev.acceleration,
+                                    k.pose,    k.velocity,    k.acceleration};
+    const SharedInterpolatedPose* last = nullptr;
     SE3 T_mr_tau;
-    for (const TimedPoint& p : scan.keypoints) {
-      const double tau = std::clamp(p.time, prev.t, k.t);
-      if (!shared || tau != shared_tau) {
-        shared = std::make_shared<const SharedInterpolatedPose>(impl_->model, prev.t, k.t, tau);
-        shared_tau = tau;
-        const double* blocks[6] = {prev.pose, prev.velocity, prev.acceleration,
-                                   k.pose,    k.velocity,    k.acceleration};
-        shared->Pose(blocks, &T_mr_tau, nullptr, nullptr);
+    for (size_t i = 0; i < scan.keypoints.size(); ++i) {
+      const TimedPoint& p = scan.keypoints[i];
+      if (interpolation[i].get() != last) {
+        last = interpolation[i].get();
+        last->Pose(knot_blocks, &T_mr_tau, nullptr, nullptr);
         T_mr_tau = T_mr_tau.Inverse();
       }
       PlaneAssociation a;
       if (!associator.Associate(p.point, T_mr_tau * p.point, &a)) continue;
       a.weight /= config_.frontend.point_noise_sigma;
-      lidar_blocks.push_back(problem_.AddResidualBlock(
-          new FiringPointToPlane(shared, a), lidar_loss_.get(), prev.pose, prev.velocity,
-          prev.acceleration, k.pose, k.velocity, k.acceleration));
+      blocks->push_back(
+          window_.AddResidualBlock(new FiringPointToPlane(interpolation[i], a), loss, gp_states));
     }
-    result->associations = static_cast<int>(lidar_blocks.size());
-    if (static_cast<int>(lidar_blocks.size()) < config_.min_associations) {
-      for (ceres::ResidualBlockId id : lidar_blocks) problem_.RemoveResidualBlock(id);
-      lidar_blocks.clear();
-      degenerate = true;
-    }
-    result->ms_associate += ms_since(t0);
-    t0 = Clock::now();
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem_, &summary);
-    result->ms_solve += ms_since(t0);
-    result->rounds = round + 1;
-    result->solver_iterations += static_cast<int>(summary.iterations.size());
-    result->final_cost = summary.final_cost;
-    const SE3 T_new = PoseManifold::Pose(k.pose);
-    const Vec6 step = (T_new * last_pose.Inverse()).Log();
-    last_pose = T_new;
-    if (degenerate || (step.head<3>().norm() < config_.frontend.convergence_translation &&
-                       step.tail<3>().norm() < config_.frontend.convergence_rotation)) {
-      break;
-    }
-  }
+  };
+  const bool degenerate = SolveRounds(
+      add_lidar, [&k] { return PoseManifold::Pose(k.pose); }, result);
 
   // Map update: every preprocessed point at its own interpolated pose.
-  const auto t_map = Clock::now();
+  const auto t_map = std::chrono::steady_clock::now();
   const SE3 T_mr_end = PoseManifold::Pose(k.pose).Inverse();
   const SE3 T_mr_prev = PoseManifold::Pose(prev.pose).Inverse();
   const double jump = (T_mr_end.translation() - T_mr_prev.translation()).norm();
@@ -240,34 +224,22 @@ void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
     }
     frontend_.UpdateMap(map_points, T_mr_end.translation());
   }
-  if (degenerate && result->status == ScanStatus::kOk) {
-    result->status = ScanStatus::kDegenerate;
-    result->message = "only " + std::to_string(result->associations) +
-                      " plane associations (need " + std::to_string(config_.min_associations) +
-                      "): lidar term dropped, prior" + (uses_imu() ? " + IMU" : "") +
-                      " carry the state";
-  }
-  result->ms_map = ms_since(t_map);
+  if (degenerate) ReportDegenerate(result);
+  result->ms_map =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_map).count();
   Fill(k, result);
-  knots_.push_back(std::move(owned));
-  Slide();
 }
 
-// Window of SPEC §4: the `window_knots` newest knots are free and the one before is held
-// constant. Once a knot is held, every factor that touches only it and older knots is constant
-// and has no effect on the free knots: its marginal prior would act on a held block. So the
-// oldest (held) knot can be removed with its factors without changing the solution, and the
-// next one becomes the held knot.
-void SingerLio::Slide() {
-  const int free_knots = static_cast<int>(knots_.size()) - 1;
-  if (free_knots <= config_.window_knots) return;
-  SetKnotConstant(knots_[1].get());
-  Knot& old = *knots_.front();
-  problem_.RemoveParameterBlock(old.pose);
-  problem_.RemoveParameterBlock(old.velocity);
-  problem_.RemoveParameterBlock(old.acceleration);
-  if (uses_imu()) problem_.RemoveParameterBlock(old.bias);
-  knots_.pop_front();
+// Window (SPEC §4, §5): before a new knot is added, the oldest knots are marginalised by Schur
+// complement until window_knots − 1 remain, so the solve has the window_knots newest knots free
+// (the newest added next) and one marginal prior carrying everything older — the lidar,
+// IMU and GP factors of the leaving knot are linearised at their current estimate and folded into
+// it (first-estimate Jacobians), not dropped.
+void SingerLio::Slide(ScanResult* result) {
+  while (static_cast<int>(knots_.size()) > config_.window_knots - 1) {
+    MarginalizeStates(knots_.front().ids(), result);
+    knots_.pop_front();
+  }
 }
 
 }  // namespace ctlio::lio

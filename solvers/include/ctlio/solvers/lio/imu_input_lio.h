@@ -5,9 +5,6 @@
 // window scheme as Singer-LIO (SingerLio), so that only the motion model differs.
 #pragma once
 
-#include <ceres/loss_function.h>
-#include <ceres/problem.h>
-
 #include <deque>
 #include <memory>
 #include <vector>
@@ -23,13 +20,17 @@ class ImuInputLio final : public LioOdometry {
   ~ImuInputLio() override;
 
  private:
+  // A state's blocks live in the window; ids 8·n + {0 pose T_wb, 1 v (world), 3 bias}.
   struct State {
     double t = 0.0;
     int64_t t_ns = 0;
-    double pose[7] = {0, 0, 0, 0, 0, 0, 1};  // T_wb = T_mr (body → world = map)
-    double velocity[3] = {0, 0, 0};          // world frame
-    double bias[6] = {0, 0, 0, 0, 0, 0};     // [b_a; b_g]
+    StateId id = 0;
+    double* pose = nullptr;      // T_wb = T_mr (body → world = map)
+    double* velocity = nullptr;  // world frame, 3
+    double* bias = nullptr;      // [b_a; b_g]
+    std::vector<StateId> ids() const { return {id, id + 1, id + 3}; }
   };
+  State AddState(double t, int64_t t_ns, const SE3& T_wb, const Vec3& v, const Vec6& bias);
 
   void Initialise(const PreparedScan& scan, ScanResult* result) override;
   void Process(const PreparedScan& scan, ScanResult* result) override;
@@ -42,13 +43,11 @@ class ImuInputLio final : public LioOdometry {
     SE3 Interpolate(double tau) const;
   };
   DeskewTable Integrate(const State& from, double t_end) const;
-  void Slide();
+  void Slide(ScanResult* result);
   void Fill(const State& s, ScanStatus status, ScanResult* result) const;
 
-  ceres::Problem problem_;
-  PoseManifold pose_manifold_;
-  std::unique_ptr<ceres::LossFunction> lidar_loss_;
-  std::deque<std::unique_ptr<State>> states_;  // oldest first; front is held constant
+  std::deque<State> states_;  // oldest first
+  int64_t next_state_ = 0;
 };
 
 }  // namespace ctlio::lio

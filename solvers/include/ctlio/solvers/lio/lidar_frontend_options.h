@@ -25,6 +25,10 @@ struct LidarFrontendOptions {
 
   // Keypoints: one per keypoint_voxel_size voxel of the subsampled sweep.
   double keypoint_voxel_size = 1.0;
+  // At most this many keypoints per sweep (0 = no cap): beyond it, an evenly spaced subset (in
+  // firing order, so the sweep's time span stays covered). Bounds the per-scan cost in large,
+  // open scenes (KISS-ICP style): a 100 m room at 1 m keypoint voxels gives ~20 000 keypoints.
+  int max_keypoints = 0;
 
   // Voxel hash map.
   double map_voxel_size = 1.0;

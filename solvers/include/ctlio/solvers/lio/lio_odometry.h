@@ -10,12 +10,14 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/sliding_window.h"
 
 namespace ctlio::lio {
 
@@ -48,6 +50,12 @@ class LioOdometry {
   bool initialised() const { return initialised_; }
   // Gravity-aligned frame i → map frame m (valid once initialised()).
   const Mat3& C_mi() const { return C_mi_; }
+  // The window the pipeline solves (SPEC §5): its states, residual blocks and marginal prior.
+  const SlidingWindow& window() const { return window_; }
+  SlidingWindow& window() { return window_; }
+  // What the most recent Schur-complement marginalisation did (empty before the first one).
+  const MarginalizationReport& last_marginalization() const { return last_marginalization_; }
+  int num_marginalizations() const { return num_marginalizations_; }
 
  protected:
   // A scan prepared for the estimators: robot-frame points, times in seconds relative to the
@@ -74,8 +82,29 @@ class LioOdometry {
   // Drops samples that can no longer be needed (older than t minus one sample).
   void TrimImu(double t);
 
+  // The association/solve rounds both pipelines share (SPEC §4): each round removes the previous
+  // round's lidar residuals, lets `add_lidar` add this round's (through window_, from the current
+  // estimate), drops them all if fewer than config.min_associations (degenerate scan: the prior
+  // and IMU carry the state), and solves the window; stops when `newest_pose` moves less than the
+  // convergence thresholds. `new_loss` gives the robust loss of one round (the window owns it).
+  // Fills rounds, iterations, cost, associations and the associate/solve times; returns whether
+  // the scan was degenerate. The lidar residuals of the last round stay in the window.
+  using AddLidarResiduals =
+      std::function<void(ceres::LossFunction* loss, std::vector<ceres::ResidualBlockId>* blocks)>;
+  bool SolveRounds(const AddLidarResiduals& add_lidar, const std::function<SE3()>& newest_pose,
+                   ScanResult* result);
+  // Schur-complement marginalisation of the given states into one prior on the states they are
+  // connected to (SlidingWindow::Marginalize, SPEC §5); times it into result->ms_marginalize.
+  void MarginalizeStates(const std::vector<StateId>& ids, ScanResult* result);
+  // Sets the status/message of a degenerate scan unless something worse was reported.
+  void ReportDegenerate(ScanResult* result) const;
+  // A new lidar loss (cauchy/huber per config, nullptr for none); the window takes ownership
+  // once a residual uses it (ref-counted by Ceres), so the caller deletes it only if unused.
+  ceres::LossFunction* NewLidarLoss() const;
+
   LidarFrontend frontend_;
   OdometryConfig config_;
+  SlidingWindow window_;
   Mat3 C_mi_ = Mat3::Identity();
   Vec3 gravity_map() const { return C_mi_ * Vec3(0, 0, -config_.gravity); }
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
@@ -90,6 +119,8 @@ class LioOdometry {
   bool have_origin_ = false;
   bool initialised_ = false;
   std::vector<ScanResult> results_;
+  MarginalizationReport last_marginalization_;
+  int num_marginalizations_ = 0;
 };
 
 // The pipeline of config.method.
