@@ -219,27 +219,52 @@ TrajectoryEstimate ImuAsInput::Smooth(const Trajectory& traj, const InputSchedul
   return SolveChain<2>(factors, states, n, eval, PositionNodes(traj));
 }
 
-double ImuAsInput::LogLikelihood(const Trajectory& traj, const InputSchedule& schedule) const {
+InputData SummarizeInputs(const Trajectory& traj, const InputSchedule& schedule) {
   CheckPositions(traj);
+  if (schedule.intervals.size() + 1 != traj.position.size()) {
+    throw std::invalid_argument(Where(__LINE__) + "input schedule does not match the trajectory");
+  }
+  InputData data;
+  data.positions = traj.position;
+  for (const auto& interval : schedule.intervals) {
+    InputIntervalSummary s;
+    for (const auto& h : interval) {
+      // The recursion of ImuInputPreintegration::Integrate with the variance split in two:
+      // x ← A x + B u, Σ ← A Σ Aᵀ + var·B Bᵀ, A = [[1, δ], [0, 1]], B = [δ²/2; δ].
+      const double d = h.duration;
+      Eigen::Matrix2d A;
+      A << 1.0, d, 0.0, 1.0;
+      const Eigen::Vector2d B(0.5 * d * d, d);
+      s.delta_p += s.delta_v * d + 0.5 * h.input * d * d;
+      s.delta_v += h.input * d;
+      s.unit_covariance = A * s.unit_covariance * A.transpose() + B * B.transpose();
+      s.age_covariance = A * s.age_covariance * A.transpose() + h.age * B * B.transpose();
+      s.dt += d;
+    }
+    data.intervals.push_back(s);
+  }
+  return data;
+}
+
+double ImuAsInput::LogLikelihood(const Trajectory& traj, const InputSchedule& schedule) const {
+  return LogLikelihood(SummarizeInputs(traj, schedule));
+}
+
+double ImuAsInput::LogLikelihood(const InputData& data) const {
+  if (data.positions.empty() || data.intervals.size() + 1 != data.positions.size()) {
+    throw std::invalid_argument(Where(__LINE__) + "input summaries do not match the positions");
+  }
   Eigen::Vector2d x = sensors_.x0_mean.head<2>();
   Eigen::Matrix2d P = sensors_.p0_variance * Eigen::Matrix2d::Identity();
   const double r = sensors_.sigma_position * sensors_.sigma_position;
-  double ll = ScalarUpdate<2>(0, traj.position[0].value, r, &x, &P);
-  for (size_t i = 0; i + 1 < traj.position.size(); ++i) {
-    for (const auto& h : schedule.intervals[i]) {
-      // x ← A x + B u, P ← A P Aᵀ + q B Bᵀ with A = [[1, δ], [0, 1]], B = [δ²/2, δ].
-      const double d = h.duration;
-      const double q = StretchVariance(h);
-      x[0] += x[1] * d + 0.5 * h.input * d * d;
-      x[1] += h.input * d;
-      const double p00 = P(0, 0) + 2.0 * d * P(0, 1) + d * d * P(1, 1);
-      const double p01 = P(0, 1) + d * P(1, 1);
-      const double b0 = 0.5 * d * d, b1 = d;
-      P(0, 0) = p00 + q * b0 * b0;
-      P(0, 1) = P(1, 0) = p01 + q * b0 * b1;
-      P(1, 1) += q * b1 * b1;
-    }
-    ll += ScalarUpdate<2>(0, traj.position[i + 1].value, r, &x, &P);
+  double ll = ScalarUpdate<2>(0, data.positions[0].value, r, &x, &P);
+  for (size_t i = 0; i < data.intervals.size(); ++i) {
+    const InputIntervalSummary& s = data.intervals[i];
+    Eigen::Matrix2d A;
+    A << 1.0, s.dt, 0.0, 1.0;
+    x = A * x + Eigen::Vector2d(s.delta_p, s.delta_v);
+    P = A * P * A.transpose() + hyper_.q_k * s.unit_covariance + jerk_intensity_ * s.age_covariance;
+    ll += ScalarUpdate<2>(0, data.positions[i + 1].value, r, &x, &P);
   }
   return ll;
 }

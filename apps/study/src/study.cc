@@ -78,8 +78,22 @@ DatasetResult RunDataset(const DatasetConfig& dataset, const StudyConfig& config
   const SensorModel sensors = MakeSensorModel(dataset, config.sensors);
 
   report("simulate validation", 0, config.validation_trajectories);
+  // Further validation trajectories for the Q_k likelihood, kept only as interval summaries.
+  const int extra =
+      std::max(0, config.input_validation_trajectories - config.validation_trajectories);
+  std::vector<InputData> extra_input(extra);
+  {
+    const SensorConfig& vs =
+        config.validation_sensors ? *config.validation_sensors : config.sensors;
+    ParallelFor(extra, config.threads, [&](int i, int) {
+      const Trajectory traj =
+          Simulate(dataset, vs, config.seed, kValidationSet, config.validation_trajectories + i);
+      extra_input[i] = SummarizeInputs(traj, BuildInputSchedule(traj));
+    });
+  }
   const ValidationSet validation = MakeValidationSet(
-      SimulateSet(dataset, config, kValidationSet, config.validation_trajectories, config.threads));
+      SimulateSet(dataset, config, kValidationSet, config.validation_trajectories, config.threads),
+      std::move(extra_input));
   report("train (max likelihood)", 0, 2);
   result.input_ml =
       TrainImuAsInput(validation, sensors, TrainingCriterion::kMaxLikelihood, config.threads);
@@ -107,37 +121,43 @@ DatasetResult RunDataset(const DatasetConfig& dataset, const StudyConfig& config
   const Trajectory first = Simulate(dataset, config.sensors, config.seed, kTestSet, 0);
   for (const auto& m : first.position) result.times.push_back(first.Time(m.node));
   const int num_times = static_cast<int>(result.times.size());
-  std::vector<ErrorStatistics> input_stats(threads, ErrorStatistics(num_times, 2));
-  std::vector<ErrorStatistics> meas_stats(threads, ErrorStatistics(num_times, 3));
-  std::vector<double> het_mean(threads, 0.0), het_cov(threads, 0.0);
+  // Fixed chunks of consecutive trajectories, each accumulated in order and merged in chunk
+  // order: the floating-point sums do not depend on the number of threads.
+  constexpr int kChunk = 10;
+  const int chunks = (n + kChunk - 1) / kChunk;
+  std::vector<ErrorStatistics> input_stats(chunks, ErrorStatistics(num_times, 2));
+  std::vector<ErrorStatistics> meas_stats(chunks, ErrorStatistics(num_times, 3));
+  std::vector<double> het_mean(chunks, 0.0), het_cov(chunks, 0.0);
   result.samples.resize(std::min(config.samples_to_keep, n));
   std::mutex mutex;
   int done = 0;
-  ParallelFor(n, threads, [&](int i, int t) {
-    const Trajectory traj = Simulate(dataset, config.sensors, config.seed, kTestSet, i);
-    const InputSchedule schedule = BuildInputSchedule(traj);
-    TrajectoryEstimate e1 = input.Smooth(traj, schedule);
-    TrajectoryEstimate e2 = measurement.Smooth(traj);
-    input_stats[t].Add(traj, e1);
-    meas_stats[t].Add(traj, e2);
-    if (i < config.heterogeneous_checks) {
-      const TrajectoryEstimate h = measurement.SmoothPreintegrated(traj);
-      for (size_t k = 0; k < h.nodes.size(); ++k) {
-        het_mean[t] = std::max(het_mean[t], (h.mean[k] - e2.mean[k]).cwiseAbs().maxCoeff());
-        het_cov[t] =
-            std::max(het_cov[t], (h.covariance[k] - e2.covariance[k]).cwiseAbs().maxCoeff());
+  ParallelFor(chunks, threads, [&](int t, int) {
+    for (int i = t * kChunk; i < std::min(n, (t + 1) * kChunk); ++i) {
+      const Trajectory traj = Simulate(dataset, config.sensors, config.seed, kTestSet, i);
+      const InputSchedule schedule = BuildInputSchedule(traj);
+      TrajectoryEstimate e1 = input.Smooth(traj, schedule);
+      TrajectoryEstimate e2 = measurement.Smooth(traj);
+      input_stats[t].Add(traj, e1);
+      meas_stats[t].Add(traj, e2);
+      if (i < config.heterogeneous_checks) {
+        const TrajectoryEstimate h = measurement.SmoothPreintegrated(traj);
+        for (size_t k = 0; k < h.nodes.size(); ++k) {
+          het_mean[t] = std::max(het_mean[t], (h.mean[k] - e2.mean[k]).cwiseAbs().maxCoeff());
+          het_cov[t] =
+              std::max(het_cov[t], (h.covariance[k] - e2.covariance[k]).cwiseAbs().maxCoeff());
+        }
       }
+      if (i < static_cast<int>(result.samples.size())) {
+        result.samples[i] = SampleTrajectory{traj, std::move(e1), std::move(e2)};
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      if (done % std::max(1, n / 20) == 0 || done == n) report("test", done, n);
     }
-    if (i < static_cast<int>(result.samples.size())) {
-      result.samples[i] = SampleTrajectory{traj, std::move(e1), std::move(e2)};
-    }
-    std::lock_guard<std::mutex> lock(mutex);
-    ++done;
-    if (done % std::max(1, n / 20) == 0 || done == n) report("test", done, n);
   });
   result.input_stats = input_stats[0];
   result.measurement_stats = meas_stats[0];
-  for (int t = 1; t < threads; ++t) {
+  for (int t = 1; t < chunks; ++t) {
     result.input_stats.Merge(input_stats[t]);
     result.measurement_stats.Merge(meas_stats[t]);
   }

@@ -130,10 +130,15 @@ Eigen::VectorXd NelderMead(const std::function<double(const Eigen::VectorXd&)>& 
   return x[best];
 }
 
-ValidationSet MakeValidationSet(std::vector<Trajectory> trajectories) {
+ValidationSet MakeValidationSet(std::vector<Trajectory> trajectories,
+                                std::vector<InputData> extra_input) {
   ValidationSet set;
   set.trajectories = std::move(trajectories);
-  for (const auto& t : set.trajectories) set.schedules.push_back(BuildInputSchedule(t));
+  for (const auto& t : set.trajectories) {
+    set.schedules.push_back(BuildInputSchedule(t));
+    set.input.push_back(SummarizeInputs(t, set.schedules.back()));
+  }
+  for (auto& d : extra_input) set.input.push_back(std::move(d));
   return set;
 }
 
@@ -158,14 +163,16 @@ double PositionMse(const Trajectory& traj, const TrajectoryEstimate& est) {
 
 InputTraining TrainImuAsInput(const ValidationSet& set, const SensorModel& sensors,
                               TrainingCriterion criterion, int threads, int subset) {
-  const int n = SubsetSize(set, subset);
+  const int n = criterion == TrainingCriterion::kMaxLikelihood
+                    ? static_cast<int>(subset > 0 ? std::min<size_t>(subset, set.input.size())
+                                                  : set.input.size())
+                    : SubsetSize(set, subset);
+  if (n == 0) throw std::invalid_argument(std::string(__FILE__) + ": empty validation set");
   // Search on log Q_k: the objective is smooth and unimodal in it; [1e-6, 10] m²/s⁴.
   auto objective = [&](double log_q) {
     const ImuAsInput est(sensors, InputHyperparameters{std::exp(log_q)});
     if (criterion == TrainingCriterion::kMaxLikelihood) {
-      return -ParallelSum(n, threads, [&](int i) {
-        return est.LogLikelihood(set.trajectories[i], set.schedules[i]);
-      });
+      return -ParallelSum(n, threads, [&](int i) { return est.LogLikelihood(set.input[i]); });
     }
     return std::sqrt(ParallelSum(n, threads,
                                  [&](int i) {

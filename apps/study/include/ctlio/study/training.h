@@ -25,11 +25,16 @@ Eigen::VectorXd NelderMead(const std::function<double(const Eigen::VectorXd&)>& 
                            const Eigen::VectorXd& start, const Eigen::VectorXd& step, double ftol,
                            int max_evaluations, int* evaluations);
 
+// `trajectories` (full, with schedules) train IMU as measurement and the min-RMSE criterion;
+// `input` holds the IMU-as-input summaries of those trajectories followed by any further
+// validation trajectories that only the Q_k likelihood uses (see StudyConfig).
 struct ValidationSet {
   std::vector<Trajectory> trajectories;
   std::vector<InputSchedule> schedules;
+  std::vector<InputData> input;
 };
-ValidationSet MakeValidationSet(std::vector<Trajectory> trajectories);
+ValidationSet MakeValidationSet(std::vector<Trajectory> trajectories,
+                                std::vector<InputData> extra_input = {});
 
 enum class TrainingCriterion { kMaxLikelihood, kMinRmse };
 
@@ -45,6 +50,7 @@ struct MeasurementTraining {
 };
 
 // `subset` > 0 limits the trajectories used (the RMSE criterion runs the smoother each time).
+// The input likelihood uses every entry of set.input, the other criteria set.trajectories.
 InputTraining TrainImuAsInput(const ValidationSet& set, const SensorModel& sensors,
                               TrainingCriterion criterion, int threads, int subset = 0);
 MeasurementTraining TrainImuAsMeasurement(const ValidationSet& set, const SensorModel& sensors,
