@@ -53,6 +53,10 @@ struct PaperFit {
 TEST(DefaultStudy, TrainedHyperparametersAndImuAsInputConsistency) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "full-size statistical test skipped under sanitizers";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+  GTEST_SKIP() << "full-size statistical test skipped under sanitizers";
+#endif
 #endif
   const StudyConfig config;
   const double dt = 1.0 / 400.0, s2 = 0.05 * 0.05;
