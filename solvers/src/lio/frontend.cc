@@ -57,7 +57,9 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
   if (points.empty()) return out;
   size_t capacity = 16;
   while (capacity < 2 * points.size()) capacity <<= 1;
-  std::vector<uint64_t> table(capacity, kEmpty);
+  // Reused across calls (per thread): a fresh multi-MB table per sweep costs page faults.
+  thread_local std::vector<uint64_t> table;
+  table.assign(capacity, kEmpty);
   const uint64_t mask = capacity - 1;
   const double inverse_size = 1.0 / voxel_size;
   for (const TimedPoint& p : points) {
@@ -87,7 +89,10 @@ bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plan
     cov.noalias() += d * d.transpose();
   }
   cov /= static_cast<double>(n);
-  const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  // Closed-form 3×3 eigen-decomposition (several times faster than the iterative QL solver;
+  // the plane normal's eigenvalue is well separated for the planar patches that pass the gate).
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(cov);
   if (es.info() != Eigen::Success) return false;
   // Eigenvalues ascending: λ0 ≤ λ1 ≤ λ2, σ1 = √λ2 ≥ σ2 = √λ1 ≥ σ3 = √λ0.
   const Vec3 lambda = es.eigenvalues().cwiseMax(0.0);
@@ -158,7 +163,14 @@ std::vector<TimedPoint> LidarFrontend::Keypoints(
 
 void LidarFrontend::UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map) {
   map_.Insert(points_map);
-  map_.RemoveFar(robot_position_map);
+  // RemoveFar visits every voxel (tens of thousands): run it only once the robot has moved 5% of
+  // max_map_distance since the last pass, so a voxel outlives the bound by at most that much.
+  if (!removal_done_ ||
+      (robot_position_map - last_removal_position_).norm() > 0.05 * options_.max_map_distance) {
+    map_.RemoveFar(robot_position_map);
+    last_removal_position_ = robot_position_map;
+    removal_done_ = true;
+  }
 }
 
 }  // namespace ctlio::lio

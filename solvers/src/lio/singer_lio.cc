@@ -211,13 +211,25 @@ void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
     result->status = ScanStatus::kFailed;
     result->message = m.str();
   } else {
+    // The GP pose on a 1 ms grid over the interval, and between grid nodes the constant twist
+    // of the node pair (geodesic interpolation): the deviation from the GP mean is
+    // ~½·|ω̇|·(0.5 ms)², 1.3e-5 rad at 100 rad/s² (0.6 mm at 50 m), while the 1 800 firings
+    // of a sweep no longer each need their own GP interpolator.
+    const int nodes = std::max(2, static_cast<int>(std::ceil((k.t - prev.t) / 1e-3)) + 1);
+    const double step = (k.t - prev.t) / (nodes - 1);
+    std::vector<SE3> grid(nodes);
+    std::vector<Vec6> twist(nodes - 1);
+    for (int j = 0; j < nodes; ++j) grid[j] = PoseAt(prev, k, prev.t + j * step);
+    for (int j = 0; j + 1 < nodes; ++j) twist[j] = (grid[j + 1] * grid[j].Inverse()).Log();
     std::vector<Vec3> map_points;
     map_points.reserve(scan.points.size());
     double last_tau = -1.0;
     SE3 T_mr_tau;
     for (const TimedPoint& p : scan.points) {
-      if (p.time != last_tau) {  // points of one firing share the interpolation
-        T_mr_tau = PoseAt(prev, k, p.time);
+      if (p.time != last_tau) {  // points of one firing share the pose
+        const double u = std::clamp((p.time - prev.t) / step, 0.0, nodes - 1.0);
+        const int j = std::min(static_cast<int>(u), nodes - 2);
+        T_mr_tau = SE3::Exp((u - j) * twist[j]) * grid[j];
         last_tau = p.time;
       }
       map_points.push_back(T_mr_tau * p.point);

@@ -72,7 +72,8 @@ class LidarFrontend {
   // One keypoint per keypoint_voxel_size voxel of a preprocessed sweep.
   std::vector<TimedPoint> Keypoints(const std::vector<TimedPoint>& preprocessed) const;
 
-  // Inserts map-frame points and drops the voxels far from the robot position.
+  // Inserts map-frame points and drops the voxels farther than max_map_distance from the robot
+  // position (checked whenever the robot has moved 5% of that distance since the last check).
   void UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map);
 
   const VoxelMap& map() const { return map_; }
@@ -86,6 +87,8 @@ class LidarFrontend {
   LidarFrontendOptions options_;
   VoxelMap map_;
   int num_scans_ = 0;
+  Vec3 last_removal_position_ = Vec3::Zero();
+  bool removal_done_ = false;
 };
 
 }  // namespace ctlio::lio
