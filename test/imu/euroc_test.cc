@@ -118,10 +118,10 @@ TEST(EurocData, OneSecondPreintegrationWindowsMatchGroundTruth) {
 // moves Euler roll by up to ε/cos(pitch) = 2.6ε, the excess being a rotation about the vertical
 // (the unobservable yaw), not an error in the gravity direction. They are printed beside δ.
 // The window: the first second. The ground truth is still there (asserted below) for ~5 s;
-// longer (2–3 s) or later (0.1–0.5 s in) windows give tilt errors 0.54–0.60° at a cold start
-// (measured), so neither more samples nor skipping the first ones changes the result: it is not
-// noise. It is the accelerometer bias, unobservable while still: with the vicon2gt bias removed
-// the tilt error drops from 0.58° to 0.20°.
+// 1–3 s windows starting 0–0.5 s in give tilt errors 0.46–0.60° at a cold start and 0.19–0.22°
+// with the bias removed (measured), so neither more samples nor skipping the first ones changes
+// the result: it is not noise. It is the accelerometer bias, unobservable while still: with the
+// vicon2gt bias removed the tilt error drops from 0.58° to 0.20°.
 TEST(EurocData, GravityInitializationRecoversRollPitch) {
   SKIP_WITHOUT_DATA();
   const std::vector<ImuSample>& imu = Imu();
