@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
@@ -22,12 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path TempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("ctlio_dataset_test_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path TempDir(const std::string& name) { return testing::FreshTempDir("dataset_test_" + name); }
 
 sim::SimConfig SmallSim() {
   sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 1);

@@ -9,18 +9,15 @@
 #include <fstream>
 #include <random>
 
+#include "common/temp_dir.h"
+
 namespace ctlio::io {
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path TempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("ctlio_io_test_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path TempDir(const std::string& name) { return testing::FreshTempDir("io_test_" + name); }
 
 PointCloud RandomCloud(size_t n, int64_t stamp) {
   std::mt19937 rng(7);

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/temp_dir.h"
+
 namespace ctlio::io {
 namespace {
 
@@ -27,8 +29,7 @@ TEST(TrajectoryIo, SecondsParseExactlyToNanoseconds) {
 }
 
 TEST(TrajectoryIo, TumAndKittiRoundTrip) {
-  const fs::path d = fs::temp_directory_path() / "ctlio_traj_io_test";
-  fs::create_directories(d);
+  const fs::path d = testing::FreshTempDir("traj_io_roundtrip");
   std::vector<StampedPose> poses;
   for (int i = 0; i < 50; ++i) {
     poses.push_back({1583836591000000000LL + i * 100000007LL,
@@ -49,8 +50,7 @@ TEST(TrajectoryIo, TumAndKittiRoundTrip) {
 }
 
 TEST(TrajectoryIo, BadLinesNameFileAndLine) {
-  const fs::path d = fs::temp_directory_path() / "ctlio_traj_io_test";
-  fs::create_directories(d);
+  const fs::path d = testing::FreshTempDir("traj_io_bad_lines");
   const std::string p = (d / "bad.txt").string();
   auto expect = [&](const std::string& text, const std::vector<std::string>& parts) {
     std::ofstream(p) << text;

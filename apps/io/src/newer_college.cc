@@ -99,10 +99,8 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
     ExpectFields(imu_path, row, 9);
     ImuSample s;
     s.t_ns = StampFromSecNsec(imu_path, row, 1);
-    s.gyro =
-        Vec3(ToDouble(imu_path, row, 3), ToDouble(imu_path, row, 4), ToDouble(imu_path, row, 5));
-    s.accel =
-        Vec3(ToDouble(imu_path, row, 6), ToDouble(imu_path, row, 7), ToDouble(imu_path, row, 8));
+    s.gyro = ToVec3(imu_path, row, 3);
+    s.accel = ToVec3(imu_path, row, 6);
     imu_.push_back(s);
     lines.push_back(row.line);
   }

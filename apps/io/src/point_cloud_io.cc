@@ -138,49 +138,32 @@ const pcl::PCLPointField* FindField(const pcl::PCLPointCloud2& c, const std::str
   return nullptr;
 }
 
+template <typename T>
+double Load(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // fields need not be aligned
+  return static_cast<double>(v);
+}
+
 // Reads a scalar field of any PCL numeric type as double.
 double ReadScalar(const uint8_t* p, uint8_t type) {
   switch (type) {
-    case pcl::PCLPointField::INT8: {
-      int8_t v;
-      std::memcpy(&v, p, 1);
-      return v;
-    }
-    case pcl::PCLPointField::UINT8: {
-      uint8_t v;
-      std::memcpy(&v, p, 1);
-      return v;
-    }
-    case pcl::PCLPointField::INT16: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    case pcl::PCLPointField::UINT16: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    case pcl::PCLPointField::INT32: {
-      int32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case pcl::PCLPointField::UINT32: {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case pcl::PCLPointField::FLOAT32: {
-      float v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case pcl::PCLPointField::FLOAT64: {
-      double v;
-      std::memcpy(&v, p, 8);
-      return v;
-    }
+    case pcl::PCLPointField::INT8:
+      return Load<int8_t>(p);
+    case pcl::PCLPointField::UINT8:
+      return Load<uint8_t>(p);
+    case pcl::PCLPointField::INT16:
+      return Load<int16_t>(p);
+    case pcl::PCLPointField::UINT16:
+      return Load<uint16_t>(p);
+    case pcl::PCLPointField::INT32:
+      return Load<int32_t>(p);
+    case pcl::PCLPointField::UINT32:
+      return Load<uint32_t>(p);
+    case pcl::PCLPointField::FLOAT32:
+      return Load<float>(p);
+    case pcl::PCLPointField::FLOAT64:
+      return Load<double>(p);
     default:
       return std::numeric_limits<double>::quiet_NaN();
   }
@@ -254,6 +237,15 @@ void AddField(pcl::PCLPointCloud2* c, const std::string& name, uint8_t type) {
 template <typename T>
 void Put(uint8_t* p, const pcl::PCLPointField& f, T v) {
   std::memcpy(p + f.offset, &v, sizeof(T));
+}
+
+// One unorganised row of n zeroed points with the fields added so far.
+void AllocatePoints(pcl::PCLPointCloud2* c, size_t n) {
+  c->width = uint32_t(n);
+  c->height = 1;
+  c->is_dense = true;
+  c->row_step = c->point_step * c->width;
+  c->data.assign(size_t(c->row_step), 0);
 }
 
 uint32_t OffsetNs(const PointCloud& cloud, size_t i, const std::string& path) {
@@ -366,11 +358,7 @@ void WritePcd(const std::string& path, const PointCloud& cloud) {
   AddField<uint16_t>(&c, "noise", F::UINT16);
   AddField<uint32_t>(&c, "range", F::UINT32);
   const size_t n = cloud.size();
-  c.width = uint32_t(n);
-  c.height = 1;
-  c.is_dense = true;
-  c.row_step = c.point_step * c.width;
-  c.data.assign(size_t(c.row_step), 0);
+  AllocatePoints(&c, n);
   for (size_t i = 0; i < n; ++i) {
     uint8_t* p = c.data.data() + i * c.point_step;
     const Vec3& x = cloud.points[i];
@@ -395,11 +383,7 @@ void WritePly(const std::string& path, const PointCloud& cloud) {
   AddField<float>(&c, "z", F::FLOAT32);
   if (cloud.has_times()) AddField<uint32_t>(&c, "t", F::UINT32);
   const size_t n = cloud.size();
-  c.width = uint32_t(n);
-  c.height = 1;
-  c.is_dense = true;
-  c.row_step = c.point_step * c.width;
-  c.data.assign(size_t(c.row_step), 0);
+  AllocatePoints(&c, n);
   for (size_t i = 0; i < n; ++i) {
     uint8_t* p = c.data.data() + i * c.point_step;
     for (int k = 0; k < 3; ++k) Put<float>(p, c.fields[k], float(cloud.points[i][k]));

@@ -106,10 +106,8 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
     ExpectFields(imu_path, row, 7);
     ImuSample s;
     s.t_ns = ToInt64(imu_path, row, 0);
-    s.gyro =
-        Vec3(ToDouble(imu_path, row, 1), ToDouble(imu_path, row, 2), ToDouble(imu_path, row, 3));
-    s.accel =
-        Vec3(ToDouble(imu_path, row, 4), ToDouble(imu_path, row, 5), ToDouble(imu_path, row, 6));
+    s.gyro = ToVec3(imu_path, row, 1);
+    s.accel = ToVec3(imu_path, row, 4);
     imu_.push_back(s);
     lines.push_back(row.line);
   }
@@ -127,8 +125,7 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       const Eigen::Quaterniond q(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
                                  ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6));
       if (std::abs(q.norm() - 1.0) > 1e-3) FailAt(gt_path, row.line, "quaternion norm is not 1");
-      ground_truth_.push_back({t, SE3(q, Vec3(ToDouble(gt_path, row, 1), ToDouble(gt_path, row, 2),
-                                              ToDouble(gt_path, row, 3)))});
+      ground_truth_.push_back({t, SE3(q, ToVec3(gt_path, row, 1))});
     }
   }
 }
@@ -178,7 +175,8 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
     std::ofstream out(dir / "ctlio_sim.yaml");
-    out << "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" << y.c_str() << "\n";
+    out << "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n"
+        << y.c_str() << "\n";
     if (!out) throw std::runtime_error((dir / "ctlio_sim.yaml").string() + ": write failed");
   }
   std::ofstream imu(dir / "imu.csv"), scans(dir / "scans.csv");

@@ -102,6 +102,10 @@ double ToDouble(const std::string& path, const TableRow& row, size_t k) {
   return v;
 }
 
+Vec3 ToVec3(const std::string& path, const TableRow& row, size_t k) {
+  return Vec3(ToDouble(path, row, k), ToDouble(path, row, k + 1), ToDouble(path, row, k + 2));
+}
+
 int64_t ToInt64(const std::string& path, const TableRow& row, size_t k) {
   if (k >= row.fields.size()) FailAt(path, row.line, "missing field " + std::to_string(k + 1));
   const std::string& s = row.fields[k];

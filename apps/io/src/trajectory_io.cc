@@ -39,8 +39,7 @@ std::vector<StampedPose> ReadTum(const std::string& path) {
     if (std::abs(q.norm() - 1.0) > 1e-3) {
       FailAt(path, row.line, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
     }
-    poses.push_back(
-        {t, SE3(q, Vec3(ToDouble(path, row, 1), ToDouble(path, row, 2), ToDouble(path, row, 3)))});
+    poses.push_back({t, SE3(q, ToVec3(path, row, 1))});
   }
   return poses;
 }

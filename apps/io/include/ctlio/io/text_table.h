@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/manifolds/types.h"
+
 namespace ctlio::io {
 
 struct TableRow {
@@ -22,6 +24,8 @@ std::vector<TableRow> ReadTable(const std::string& path, bool skip_header);
 // a number". ToInt64 accepts only integers.
 double ToDouble(const std::string& path, const TableRow& row, size_t k);
 int64_t ToInt64(const std::string& path, const TableRow& row, size_t k);
+// Fields k, k+1, k+2 as a vector (x, y, z), with ToDouble's checks.
+Vec3 ToVec3(const std::string& path, const TableRow& row, size_t k);
 // Throws "<path>:<line>: expected N fields, found M" unless the row has exactly (or, with
 // `at_least`, at least) n fields.
 void ExpectFields(const std::string& path, const TableRow& row, size_t n, bool at_least = false);
