@@ -15,6 +15,21 @@
 namespace ctlio::study {
 namespace {
 
+// The statistical tests need hundreds of trajectories (minutes under ASan/UBSan at -Og); under
+// the sanitizers they are skipped, and every code path they use also runs in the small tests
+// (Study.ResultsIndependentOfThreadCount runs the whole pipeline, the smoother tests the solvers).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
 const uint64_t kSeed = StudyConfig{}.seed;  // the program's default seed (20250301)
 constexpr int kThreads = 2;
 
@@ -48,16 +63,8 @@ struct PaperFit {
 // - IMU as input with the TRAINED Q_k consistent at >= 80% of the times on the full
 //   1000-trajectory test set (bounds ±6% around 2). Only estimator 1 is smoothed here: 1000
 //   IMU-as-measurement smooths would cost too much test time (checked on 200 below).
-// Statistical tests at full size: skipped under the sanitizers (minutes there); every code path
-// they use also runs in the smaller tests.
 TEST(DefaultStudy, TrainedHyperparametersAndImuAsInputConsistency) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "full-size statistical test skipped under sanitizers";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-  GTEST_SKIP() << "full-size statistical test skipped under sanitizers";
-#endif
-#endif
+  if (kSanitized) GTEST_SKIP() << "full-size statistical test skipped under sanitizers";
   const StudyConfig config;
   const double dt = 1.0 / 400.0, s2 = 0.05 * 0.05;
   for (const PaperFit& fit : {PaperFit{WnojDataset(), 0.00338, s2 + dt / 3.0},
@@ -177,6 +184,7 @@ struct PaperSetup {
 };
 
 TEST(TestSet, BothEstimatorsUnbiasedConsistentAndIdentical) {
+  if (kSanitized) GTEST_SKIP() << "200-trajectory statistical test skipped under sanitizers";
   StudyConfig config;
   const int M = 200;
   for (const PaperSetup& setup : {PaperSetup{WnojDataset(), {0.00338}, {1.0069, 0.0}},
