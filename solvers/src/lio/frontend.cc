@@ -77,6 +77,39 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
   return out;
 }
 
+std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
+                                           double min_range, double max_range) {
+  if (!(voxel_size > 0.0)) throw std::invalid_argument("RangeGatedVoxelIndices: voxel_size <= 0");
+  std::vector<size_t> out;
+  if (points.empty()) return out;
+  size_t capacity = 16;
+  while (capacity < 2 * points.size()) capacity <<= 1;
+  thread_local std::vector<uint64_t> table;
+  table.assign(capacity, kEmpty);
+  const uint64_t mask = capacity - 1;
+  const double inverse_size = 1.0 / voxel_size;
+  const double min2 = min_range * min_range, max2 = max_range * max_range;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double r2 = points[i].squaredNorm();
+    if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops non-finite points
+    uint64_t key;
+    if (!PackedKey(points[i], inverse_size, &key)) continue;
+    for (uint64_t slot = Mix(key) & mask;; slot = (slot + 1) & mask) {
+      if (table[slot] == key) break;
+      if (table[slot] == kEmpty) {
+        table[slot] = key;
+        out.push_back(i);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+double LidarFrontend::NextVoxelSize() const {
+  return num_scans_ < options_.initial_scans ? options_.initial_voxel_size : options_.voxel_size;
+}
+
 bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
   const size_t n = neighbours.size();
   if (n < 3) return false;

@@ -230,9 +230,15 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   prepared.t_begin = Seconds(scan.begin_ns);
   prepared.t_end = Seconds(scan.end_ns);
   prepared.end_ns = scan.end_ns;
+  // Range gate and voxel subsampling in the lidar frame first (one pass, no copy of the up to
+  // 230 000 raw returns of a 128-beam sweep); Preprocess then repeats both on the few thousand
+  // survivors in the robot frame (idempotent up to the extrinsic's shift of the voxel grid).
+  const std::vector<size_t> kept =
+      RangeGatedVoxelIndices(scan.points, frontend_.NextVoxelSize(), config_.frontend.min_range,
+                             config_.frontend.max_range);
   std::vector<TimedPoint> raw;
-  raw.reserve(scan.points.size());
-  for (size_t i = 0; i < scan.points.size(); ++i) {
+  raw.reserve(kept.size());
+  for (const size_t i : kept) {
     TimedPoint p;
     p.point = config_.T_imu_lidar * scan.points[i];
     // Points are registered between the previous knot and this one; a time outside (clock

@@ -29,6 +29,11 @@ std::vector<TimedPoint> RangeGate(const std::vector<TimedPoint>& points, double 
 std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points,
                                            double voxel_size);
 
+// Indices of the points (any frame) with min_range ≤ |p| ≤ max_range that are the first of their
+// voxel: the range gate and VoxelGridSubsample in one pass over a raw sweep, without copying it.
+std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
+                                           double min_range, double max_range);
+
 // The plane through a point's neighbours.
 struct PlaneFit {
   Vec3 centroid = Vec3::Zero();
@@ -69,6 +74,8 @@ class LidarFrontend {
   // Range gate + subsampling (voxel_size, or initial_voxel_size for the first initial_scans
   // sweeps). Advances the scan counter.
   std::vector<TimedPoint> Preprocess(const std::vector<TimedPoint>& sweep);
+  // The voxel size the next Preprocess call will use.
+  double NextVoxelSize() const;
   // One keypoint per keypoint_voxel_size voxel of a preprocessed sweep.
   std::vector<TimedPoint> Keypoints(const std::vector<TimedPoint>& preprocessed) const;
 
