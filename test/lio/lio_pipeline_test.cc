@@ -4,6 +4,8 @@
 // degenerate scan (reported, estimate survives).
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -198,6 +200,37 @@ TEST(LioPipeline, LeavingKnotsAreMarginalisedIntoAnInformativePrior) {
   for (int i = 0; i < with_prior.rows(); ++i) {
     EXPECT_GT(without_prior(i, i), 4.0 * with_prior(i, i)) << "tangent coordinate " << i;
   }
+}
+
+// The one-pass range gate + subsampling on raw lidar points keeps exactly the points that
+// RangeGate followed by VoxelGridSubsample keeps (same frame), and the keypoint cap keeps an
+// evenly spaced subset in order.
+TEST(LioFrontend, OnePassSubsamplingAndKeypointCap) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-30.0, 30.0);
+  std::vector<Vec3> raw;
+  std::vector<TimedPoint> timed;
+  for (int i = 0; i < 20000; ++i) {
+    raw.emplace_back(u(rng), u(rng), 0.1 * u(rng));
+    if (i % 997 == 0) raw.back() = Vec3(0.2, 0.0, 0.0);  // inside min_range
+    timed.push_back({raw.back(), 1e-5 * i});
+  }
+  const std::vector<size_t> idx = RangeGatedVoxelIndices(raw, 0.5, 1.0, 40.0);
+  const std::vector<TimedPoint> ref = VoxelGridSubsample(RangeGate(timed, 1.0, 40.0), 0.5);
+  ASSERT_EQ(idx.size(), ref.size());
+  for (size_t i = 0; i < idx.size(); ++i) EXPECT_EQ(raw[idx[i]], ref[i].point);
+
+  LidarFrontendOptions o;
+  o.keypoint_voxel_size = 0.5;
+  o.max_keypoints = 100;
+  LidarFrontend frontend(o);
+  const std::vector<TimedPoint> all = VoxelGridSubsample(ref, 0.5);
+  ASSERT_GT(all.size(), 1000u);
+  const std::vector<TimedPoint> kp = frontend.Keypoints(ref);
+  ASSERT_EQ(kp.size(), 100u);
+  for (size_t i = 1; i < kp.size(); ++i) EXPECT_LT(kp[i - 1].time, kp[i].time);  // order kept
+  EXPECT_EQ(kp.front().time, all.front().time);
+  EXPECT_GT(kp.back().time, all[all.size() * 98 / 100].time);  // spans the whole sweep
 }
 
 }  // namespace
