@@ -1,6 +1,7 @@
 #include "ctlio/solvers/lio/frontend.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -48,6 +49,56 @@ inline uint64_t Mix(uint64_t k) {  // splitmix64 finaliser
   return k;
 }
 
+// Set of packed voxel keys (open addressing, linear probing, load ≤ 1/2) for "first point of its
+// voxel" subsampling. It starts small and doubles as voxels appear: a sweep has a few ten
+// thousand occupied voxels but up to 230 000 points, and sizing the table for the points (4 MB,
+// cleared every sweep) made most probes cache misses. Which keys are present — hence the kept
+// points and their order — does not depend on the table size.
+class PackedKeySet {
+ public:
+  // Empties the set. The table keeps the size it grew to (sweeps of one sensor occupy similar
+  // numbers of voxels, so later calls rarely rehash) and both buffers keep their capacity.
+  void Clear() {
+    if (table_.empty()) {
+      table_.assign(kInitialCapacity, kEmpty);
+      mask_ = kInitialCapacity - 1;
+    } else {
+      std::fill(table_.begin(), table_.end(), kEmpty);
+    }
+    size_ = 0;
+  }
+  // Inserts key; returns whether it was new.
+  bool Insert(uint64_t key) {
+    if (2 * (size_ + 1) > table_.size()) Grow();
+    for (uint64_t slot = Mix(key) & mask_;; slot = (slot + 1) & mask_) {
+      if (table_[slot] == key) return false;
+      if (table_[slot] == kEmpty) {
+        table_[slot] = key;
+        ++size_;
+        return true;
+      }
+    }
+  }
+
+ private:
+  static constexpr size_t kInitialCapacity = 4096;
+  void Grow() {
+    spare_.assign(2 * table_.size(), kEmpty);
+    const uint64_t mask = spare_.size() - 1;
+    for (const uint64_t key : table_) {
+      if (key == kEmpty) continue;
+      uint64_t slot = Mix(key) & mask;
+      while (spare_[slot] != kEmpty) slot = (slot + 1) & mask;
+      spare_[slot] = key;
+    }
+    table_.swap(spare_);
+    mask_ = mask;
+  }
+  std::vector<uint64_t> table_, spare_;
+  uint64_t mask_ = 0;
+  size_t size_ = 0;
+};
+
 }  // namespace
 
 std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points,
@@ -55,24 +106,14 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
   if (!(voxel_size > 0.0)) throw std::invalid_argument("VoxelGridSubsample: voxel_size <= 0");
   std::vector<TimedPoint> out;
   if (points.empty()) return out;
-  size_t capacity = 16;
-  while (capacity < 2 * points.size()) capacity <<= 1;
-  // Reused across calls (per thread): a fresh multi-MB table per sweep costs page faults.
-  thread_local std::vector<uint64_t> table;
-  table.assign(capacity, kEmpty);
-  const uint64_t mask = capacity - 1;
+  // Reused across calls (per thread): fresh tables per sweep cost allocations and page faults.
+  thread_local PackedKeySet seen;
+  seen.Clear();
   const double inverse_size = 1.0 / voxel_size;
   for (const TimedPoint& p : points) {
     uint64_t key;
     if (!PackedKey(p.point, inverse_size, &key)) continue;  // non-finite or absurdly far
-    for (uint64_t slot = Mix(key) & mask;; slot = (slot + 1) & mask) {
-      if (table[slot] == key) break;
-      if (table[slot] == kEmpty) {
-        table[slot] = key;
-        out.push_back(p);
-        break;
-      }
-    }
+    if (seen.Insert(key)) out.push_back(p);
   }
   return out;
 }
@@ -82,11 +123,8 @@ std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, doub
   if (!(voxel_size > 0.0)) throw std::invalid_argument("RangeGatedVoxelIndices: voxel_size <= 0");
   std::vector<size_t> out;
   if (points.empty()) return out;
-  size_t capacity = 16;
-  while (capacity < 2 * points.size()) capacity <<= 1;
-  thread_local std::vector<uint64_t> table;
-  table.assign(capacity, kEmpty);
-  const uint64_t mask = capacity - 1;
+  thread_local PackedKeySet seen;
+  seen.Clear();
   const double inverse_size = 1.0 / voxel_size;
   const double min2 = min_range * min_range, max2 = max_range * max_range;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -94,14 +132,7 @@ std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, doub
     if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops non-finite points
     uint64_t key;
     if (!PackedKey(points[i], inverse_size, &key)) continue;
-    for (uint64_t slot = Mix(key) & mask;; slot = (slot + 1) & mask) {
-      if (table[slot] == key) break;
-      if (table[slot] == kEmpty) {
-        table[slot] = key;
-        out.push_back(i);
-        break;
-      }
-    }
+    if (seen.Insert(key)) out.push_back(i);
   }
   return out;
 }

@@ -250,8 +250,13 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   prepared.keypoints = frontend_.Keypoints(prepared.points);
   // Time order groups the points of one firing, whose interpolated pose the pipelines share.
   const auto by_time = [](const TimedPoint& a, const TimedPoint& b) { return a.time < b.time; };
-  std::stable_sort(prepared.points.begin(), prepared.points.end(), by_time);
-  std::stable_sort(prepared.keypoints.begin(), prepared.keypoints.end(), by_time);
+  // A sweep usually arrives in firing order already: then the (allocating) sort is skipped.
+  if (!std::is_sorted(prepared.points.begin(), prepared.points.end(), by_time)) {
+    std::stable_sort(prepared.points.begin(), prepared.points.end(), by_time);
+  }
+  if (!std::is_sorted(prepared.keypoints.begin(), prepared.keypoints.end(), by_time)) {
+    std::stable_sort(prepared.keypoints.begin(), prepared.keypoints.end(), by_time);
+  }
 
   ScanResult result;
   result.ms_preprocess =

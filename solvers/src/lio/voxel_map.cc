@@ -20,20 +20,36 @@ VoxelMap::VoxelMap(const Options& options)
 
 bool VoxelMap::Insert(const Vec3& p) {
   if (!p.allFinite()) return false;
-  Voxel& voxel = voxels_[VoxelKeyOf(p, inverse_voxel_size_)];
-  if (static_cast<int>(voxel.points.size()) >= options_.max_points_per_voxel) return false;
-  for (const Vec3& existing : voxel.points) {
+  return InsertInto(&voxels_[VoxelKeyOf(p, inverse_voxel_size_)], p);
+}
+
+bool VoxelMap::InsertInto(Voxel* voxel, const Vec3& p) {
+  if (static_cast<int>(voxel->points.size()) >= options_.max_points_per_voxel) return false;
+  for (const Vec3& existing : voxel->points) {
     if ((existing - p).squaredNorm() < min_distance2_) return false;
   }
-  if (voxel.points.empty()) voxel.points.reserve(options_.max_points_per_voxel);
-  voxel.points.push_back(p);
+  if (voxel->points.empty()) voxel->points.reserve(options_.max_points_per_voxel);
+  voxel->points.push_back(p);
   ++num_points_;
   return true;
 }
 
 size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
+  // Consecutive points of a sweep (neighbouring beams of one firing) often share a voxel: reuse
+  // the previous hash-map lookup then (element pointers of std::unordered_map stay valid when
+  // it rehashes). Same result as inserting the points one by one.
   size_t kept = 0;
-  for (const Vec3& p : points) kept += Insert(p) ? 1 : 0;
+  Voxel* last_voxel = nullptr;
+  VoxelKey last_key;
+  for (const Vec3& p : points) {
+    if (!p.allFinite()) continue;
+    const VoxelKey key = VoxelKeyOf(p, inverse_voxel_size_);
+    if (last_voxel == nullptr || !(key == last_key)) {
+      last_voxel = &voxels_[key];
+      last_key = key;
+    }
+    kept += InsertInto(last_voxel, p) ? 1 : 0;
+  }
   return kept;
 }
 

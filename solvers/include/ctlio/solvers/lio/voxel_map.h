@@ -83,6 +83,8 @@ class VoxelMap {
   struct Voxel {
     std::vector<Vec3> points;
   };
+  // Insert's body once the voxel of p is known.
+  bool InsertInto(Voxel* voxel, const Vec3& p);
 
   Options options_;
   double inverse_voxel_size_;
