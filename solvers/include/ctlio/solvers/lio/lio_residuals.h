@@ -71,17 +71,16 @@ class SharedInterpolatedPose {
     for (int b = 0, o = 0; b < 6; o += sizes[b], ++b) {
       std::memcpy(key + o, parameters[b], sizes[b] * sizeof(double));
     }
-    const bool want_jacobians = J_k != nullptr || J_k1 != nullptr;
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!valid_ || (want_jacobians && !has_jacobians_) ||
-        std::memcmp(key, key_, sizeof(key)) != 0) {
+    // A miss always computes the Jacobians too: the trust-region minimiser evaluates the cost at
+    // a candidate point and, when the step succeeds, the Jacobians at that same point, which then
+    // hit the cache instead of redoing the interpolation (the pose is the same either way).
+    if (!valid_ || std::memcmp(key, key_, sizeof(key)) != 0) {
       const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
       const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
-      interpolator_.Pose(k, k1, &T_, want_jacobians ? &J_k_ : nullptr,
-                         want_jacobians ? &J_k1_ : nullptr);
+      interpolator_.Pose(k, k1, &T_, &J_k_, &J_k1_);
       std::memcpy(key_, key, sizeof(key));
       valid_ = true;
-      has_jacobians_ = want_jacobians;
     }
     *T = T_;
     if (J_k != nullptr) *J_k = J_k_;
@@ -93,7 +92,7 @@ class SharedInterpolatedPose {
   gp::GpInterpolator interpolator_;
   mutable std::mutex mutex_;
   mutable double key_[kKeySize] = {};
-  mutable bool valid_ = false, has_jacobians_ = false;
+  mutable bool valid_ = false;
   mutable SE3 T_;
   mutable gp::PoseJacobian J_k_, J_k1_;
 };
