@@ -206,8 +206,7 @@ LidarFrontend::LidarFrontend(const LidarFrontendOptions& options)
 }
 
 std::vector<TimedPoint> LidarFrontend::Preprocess(const std::vector<TimedPoint>& sweep) {
-  const double size =
-      num_scans_ < options_.initial_scans ? options_.initial_voxel_size : options_.voxel_size;
+  const double size = NextVoxelSize();
   ++num_scans_;
   return VoxelGridSubsample(RangeGate(sweep, options_.min_range, options_.max_range), size);
 }

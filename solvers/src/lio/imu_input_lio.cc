@@ -177,8 +177,7 @@ void ImuInputLio::Process(const PreparedScan& scan, ScanResult* result) {
     frontend_.UpdateMap(map_points, T_wb.translation());
   }
   if (degenerate) ReportDegenerate(result);
-  result->ms_map =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_map).count();
+  result->ms_map = MsSince(t_map);
   Fill(s, ScanStatus::kOk, result);
 }
 

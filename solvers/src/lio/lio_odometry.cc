@@ -20,10 +20,24 @@ SlidingWindowOptions WindowOptions(const OdometryConfig& config) {
   o.solver = WindowSolverOptions(config);
   return o;
 }
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+double ThreadCpuMs() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+// Time order groups the points of one firing, whose interpolated pose the pipelines share. A
+// sweep usually arrives in firing order already: then the (allocating) sort is skipped.
+void SortByTime(std::vector<TimedPoint>* points) {
+  const auto by_time = [](const TimedPoint& a, const TimedPoint& b) { return a.time < b.time; };
+  if (!std::is_sorted(points->begin(), points->end(), by_time)) {
+    std::stable_sort(points->begin(), points->end(), by_time);
+  }
 }
 }  // namespace
+
+double LioOdometry::MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
 
 LioOdometry::LioOdometry(const OdometryConfig& config)
     : frontend_(config.frontend), config_(config), window_(WindowOptions(config)) {
@@ -194,14 +208,6 @@ bool LioOdometry::InitialiseGravity(double t_end, std::string* message) {
   return true;
 }
 
-namespace {
-double ThreadCpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
-}  // namespace
-
 ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMs();
@@ -248,19 +254,11 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   }
   prepared.points = frontend_.Preprocess(raw);
   prepared.keypoints = frontend_.Keypoints(prepared.points);
-  // Time order groups the points of one firing, whose interpolated pose the pipelines share.
-  const auto by_time = [](const TimedPoint& a, const TimedPoint& b) { return a.time < b.time; };
-  // A sweep usually arrives in firing order already: then the (allocating) sort is skipped.
-  if (!std::is_sorted(prepared.points.begin(), prepared.points.end(), by_time)) {
-    std::stable_sort(prepared.points.begin(), prepared.points.end(), by_time);
-  }
-  if (!std::is_sorted(prepared.keypoints.begin(), prepared.keypoints.end(), by_time)) {
-    std::stable_sort(prepared.keypoints.begin(), prepared.keypoints.end(), by_time);
-  }
+  SortByTime(&prepared.points);
+  SortByTime(&prepared.keypoints);
 
   ScanResult result;
-  result.ms_preprocess =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.ms_preprocess = MsSince(start);
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
   try {
@@ -285,8 +283,7 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   }
   if (!initialised_) last_scan_end_ns_ = scan.end_ns;
   TrimImu(Seconds(last_scan_end_ns_) - 0.5);
-  result.milliseconds =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.milliseconds = MsSince(start);
   result.cpu_ms = ThreadCpuMs() - cpu_start;
   results_.push_back(result);
   return result;

@@ -237,8 +237,7 @@ void SingerLio::Process(const PreparedScan& scan, ScanResult* result) {
     frontend_.UpdateMap(map_points, T_mr_end.translation());
   }
   if (degenerate) ReportDegenerate(result);
-  result->ms_map =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_map).count();
+  result->ms_map = MsSince(t_map);
   Fill(k, result);
 }
 

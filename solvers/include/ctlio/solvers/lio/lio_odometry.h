@@ -9,6 +9,7 @@
 // scans, IMU gaps and initialisation failures are flagged with a message.
 #pragma once
 
+#include <chrono>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -96,6 +97,8 @@ class LioOdometry {
   // Schur-complement marginalisation of the given states into one prior on the states they are
   // connected to (SlidingWindow::Marginalize, SPEC §5); times it into result->ms_marginalize.
   void MarginalizeStates(const std::vector<StateId>& ids, ScanResult* result);
+  // Wall milliseconds since t0 (the per-stage times of ScanResult).
+  static double MsSince(std::chrono::steady_clock::time_point t0);
   // Sets the status/message of a degenerate scan unless something worse was reported.
   void ReportDegenerate(ScanResult* result) const;
   // A new lidar loss (cauchy/huber per config, nullptr for none); the window takes ownership
