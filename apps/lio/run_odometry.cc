@@ -1,5 +1,6 @@
 #include "run_odometry.h"
 
+#include <glog/logging.h>
 #include <sys/resource.h>
 
 #include <Eigen/Geometry>
@@ -30,26 +31,40 @@ double Percentile(std::vector<double> v, double p) {
   return v[lo] + (idx - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+namespace {
+
+// The truth at time t: the position (a pose within 1 ms, else interpolated linearly between poses
+// less than 0.2 s apart) and the rotation of the nearest pose. False if t is not covered.
+bool TruthAt(const std::vector<io::StampedPose>& truth, int64_t t, Vec3* p, Mat3* C) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                                   [](const io::StampedPose& q, int64_t x) { return q.t_ns < x; });
+  if (it != truth.end() && std::llabs(it->t_ns - t) <= 1000000) {
+    *p = it->pose.translation();
+    *C = it->pose.rotation();
+  } else if (it != truth.begin() && it != truth.end() && it->t_ns - (it - 1)->t_ns < 200000000) {
+    const double s = double(t - (it - 1)->t_ns) / double(it->t_ns - (it - 1)->t_ns);
+    *p = (1 - s) * (it - 1)->pose.translation() + s * it->pose.translation();
+    *C = (s < 0.5 ? (it - 1) : it)->pose.rotation();
+  } else if (it != truth.begin() && std::llabs((it - 1)->t_ns - t) <= 1000000) {
+    *p = (it - 1)->pose.translation();
+    *C = (it - 1)->pose.rotation();
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth) {
   AteResult r;
   if (truth.size() < 2) return r;
   std::vector<Vec3> est, ref;
   for (const io::StampedPose& e : estimate) {
-    const auto it =
-        std::lower_bound(truth.begin(), truth.end(), e.t_ns,
-                         [](const io::StampedPose& p, int64_t t) { return p.t_ns < t; });
     Vec3 p;
-    if (it != truth.end() && std::llabs(it->t_ns - e.t_ns) <= 1000000) {
-      p = it->pose.translation();
-    } else if (it != truth.begin() && it != truth.end() && it->t_ns - (it - 1)->t_ns < 200000000) {
-      const double s = double(e.t_ns - (it - 1)->t_ns) / double(it->t_ns - (it - 1)->t_ns);
-      p = (1 - s) * (it - 1)->pose.translation() + s * it->pose.translation();
-    } else if (it != truth.begin() && std::llabs((it - 1)->t_ns - e.t_ns) <= 1000000) {
-      p = (it - 1)->pose.translation();
-    } else {
-      continue;
-    }
+    Mat3 C;
+    if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
     est.push_back(e.pose.translation());
     ref.push_back(p);
   }
@@ -78,11 +93,21 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options, double failure_ate) {
-  // The source knows its sensor setup; it overrides the config's.
-  config.T_imu_lidar = source.ImuFromLidar();
+  RunSummary run;
+  if (options.extrinsic_from_config) {
+    run.extrinsic_origin = "the config (extrinsic:)";
+  } else {
+    config.T_imu_lidar = source.ImuFromLidar();
+    run.extrinsic_origin = source.ExtrinsicOrigin();
+  }
+  {
+    const Eigen::AngleAxisd r(config.T_imu_lidar.rotation());
+    LOG(INFO) << "T_imu_lidar from " << run.extrinsic_origin << ": translation ["
+              << config.T_imu_lidar.translation().transpose() << "] m, rotation "
+              << r.angle() * 180.0 / M_PI << " deg about [" << r.axis().transpose() << "]";
+  }
   if (const auto g = source.Gravity()) config.gravity = *g;
   auto odometry = lio::MakeLioOdometry(config);
-  RunSummary run;
   run.method = lio::LioMethodName(config.method);
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
@@ -220,6 +245,30 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
       << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << r.ms_marginalize << ' '
       << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
       << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+  }
+}
+
+}  // namespace ctlio::lioapp
+
+namespace ctlio::lioapp {
+
+void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot write the pose errors");
+  f << "t_s,est_x,est_y,est_z,ref_x,ref_y,ref_z,position_error_m,rotation_error_deg\n";
+  f << std::setprecision(12);
+  const Mat3 A = alignment.topLeftCorner<3, 3>();
+  const Vec3 a = alignment.topRightCorner<3, 1>();
+  for (const io::StampedPose& e : estimate) {
+    Vec3 p;
+    Mat3 C;
+    if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
+    const Vec3 q = A * e.pose.translation() + a;
+    const double angle = Eigen::AngleAxisd(C.transpose() * A * e.pose.rotation()).angle();
+    f << 1e-9 * double(e.t_ns) << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << p.x()
+      << ',' << p.y() << ',' << p.z() << ',' << (q - p).norm() << ',' << angle * 180.0 / M_PI
+      << '\n';
   }
 }
 

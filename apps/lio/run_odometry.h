@@ -17,6 +17,10 @@ namespace ctlio::lioapp {
 
 struct RunOptions {
   size_t max_scans = 0;  // 0 = all
+  // Extrinsic T_imu_lidar precedence: the config's value when it was given explicitly (true),
+  // otherwise the source's (a bag's /tf_static, then a dataset preset or the dataset's files; see
+  // DataSource::ExtrinsicOrigin). The choice is logged and kept in RunSummary::extrinsic_origin.
+  bool extrinsic_from_config = false;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
 };
@@ -32,6 +36,7 @@ struct AteResult {
 struct RunSummary {
   std::string method;
   std::string source;
+  std::string extrinsic_origin;  // where T_imu_lidar came from
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
   // estimated (failed scans are left out, never written as garbage).
   std::vector<io::StampedPose> trajectory;
@@ -57,6 +62,13 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
 // its two nearest poses), SE(3) Umeyama alignment.
 AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth);
+
+// Per-pose errors against the truth after `alignment` (estimate → truth frame), CSV:
+// t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg] (angle of
+// C_truthᵀ·C_align·C_est, truth rotation of the nearest truth pose). Poses outside the truth are
+// left out. Read by tools/plot_odometry.py.
+void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
 
 // Per-scan log: t, status, keypoints, associations, imu residuals, rounds, solver iterations,
 // final cost, ms, position, message.
