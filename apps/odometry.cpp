@@ -10,13 +10,17 @@
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
-// alignment) with DIR/trajectory_topview.svg (estimate over ground truth). Several methods
-// separated by commas run one after the other and print their ATE side by side.
+// alignment) and DIR/pose_errors.csv. Plots (tools/plot_odometry.py, python3-matplotlib):
+// DIR/odometry.png (top and side view in metres, errors and per-scan time/status over time) and,
+// for several methods, DIR/comparison.png; without matplotlib an SVG top view
+// (trajectory_topview.svg) instead. Several methods separated by commas run one after the other
+// and print their ATE side by side.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -46,6 +50,8 @@ DEFINE_string(time_field, "", "Per-point time field (default: detected; 'none' =
 DEFINE_string(time_unit, "", "Override the time field's unit: s | ms | us | ns");
 DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | absolute");
 DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
+DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
+DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
@@ -100,6 +106,24 @@ std::unique_ptr<io::DataSource> OpenSource() {
                            "' (newer_college, ctlio, kitti, rosbag, sim)");
 }
 
+#ifndef CTLIO_TOOLS_DIR
+#define CTLIO_TOOLS_DIR "tools"
+#endif
+
+// Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
+bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& folders) {
+  std::string python = FLAGS_python;
+  for (const char* p : {"python3", "/usr/bin/python3"}) {
+    if (!python.empty()) break;
+    const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
+    if (std::system(probe.c_str()) == 0) python = p;
+  }
+  if (python.empty()) return false;
+  std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
+  for (const std::string& f : folders) cmd += " '" + f + "'";
+  return std::system((cmd + " >/dev/null").c_str()) == 0;
+}
+
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -127,6 +151,8 @@ int main(int argc, char** argv) {
         !FLAGS_config.empty() && YAML::LoadFile(FLAGS_config)["extrinsic"].IsDefined();
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     std::vector<lioapp::RunSummary> runs;
+    std::vector<std::string> folders;
+    std::vector<std::vector<io::StampedPose>> truths;
     for (const std::string& m : methods) {
       lio::OdometryConfig config = base;
       config.method = lio::ParseLioMethod(m);
@@ -164,15 +190,34 @@ int main(int argc, char** argv) {
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
+        ev << "ate_alignment";
+        for (int r = 0; r < 4; ++r) {
+          for (int c = 0; c < 4; ++c)
+            ev << ' ' << std::setprecision(17) << run.ate->alignment(r, c);
+        }
+        ev << std::setprecision(6) << "\n";
         io::WriteTum(out + "/ground_truth.tum", *source->GroundTruth());
-        char title[160];
-        std::snprintf(title, sizeof(title), "%s on %s: ATE %.4f m", run.method.c_str(),
-                      run.source.c_str(), run.ate->rmse);
-        lioapp::WriteTopViewSvg(out + "/trajectory_topview.svg", run.trajectory,
-                                *source->GroundTruth(), run.ate->alignment, title);
+        lioapp::WritePoseErrors(out + "/pose_errors.csv", run.trajectory, *source->GroundTruth(),
+                                run.ate->alignment);
+        truths.push_back(*source->GroundTruth());
+      } else {
+        truths.emplace_back();
       }
+      if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+      folders.push_back(out);
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       runs.push_back(std::move(run));
+    }
+    if (FLAGS_plot && !PlotWithMatplotlib(FLAGS_out, folders)) {
+      std::fprintf(stderr, "plots: no python3 with matplotlib, SVG top view instead\n");
+      for (size_t k = 0; k < runs.size(); ++k) {
+        if (!runs[k].ate) continue;
+        char title[240];
+        std::snprintf(title, sizeof(title), "%s on %s: ATE %.2f cm", runs[k].method.c_str(),
+                      runs[k].source.c_str(), 100.0 * runs[k].ate->rmse);
+        lioapp::WriteTopViewSvg(folders[k] + "/trajectory_topview.svg", runs[k].trajectory,
+                                truths[k], runs[k].ate->alignment, title);
+      }
     }
     std::printf("\n%-12s %8s %8s %8s %6s %6s %9s %9s %9s %9s %9s\n", "method", "ATE[m]", "mean[m]",
                 "max[m]", "failed", "degen", "med[ms]", "p95[ms]", "cpu_med", "cpu_p95", "peakMB");

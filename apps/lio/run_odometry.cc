@@ -210,25 +210,51 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
       hi = hi.cwiseMax(p.head<2>());
     }
   }
-  const double span = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3});
-  const double size = 600, margin = 40, scale = (size - 2 * margin) / span;
+  // Square frame around the data with a "nice" tick step (1, 2 or 5 × 10^k m).
+  const double span = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3}) * 1.1;
+  const Eigen::Vector2d centre = 0.5 * (lo + hi);
+  lo = centre - Eigen::Vector2d::Constant(span / 2);
+  const double raw_step = span / 5, mag = std::pow(10.0, std::floor(std::log10(raw_step)));
+  const double step = raw_step / mag < 2 ? 2 * mag : raw_step / mag < 5 ? 5 * mag : 10 * mag;
+  // Title wrapped into lines of at most 80 characters so that it is never cut off.
+  std::vector<std::string> lines;
+  for (size_t i = 0; i < title.size(); i += 80) lines.push_back(title.substr(i, 80));
+  const double left = 70, top = 30 + 18.0 * double(lines.size()), size = 520;
+  const double scale = size / span;
+  auto X = [&](double x) { return left + (x - lo.x()) * scale; };
+  auto Y = [&](double y) { return top + size - (y - lo.y()) * scale; };
   auto polyline = [&](const std::vector<Vec3>& v, const char* colour, double width) {
     std::ostringstream s;
     s << "<polyline fill='none' stroke='" << colour << "' stroke-width='" << width << "' points='";
-    for (const Vec3& p : v) {
-      s << margin + (p.x() - lo.x()) * scale << ',' << size - margin - (p.y() - lo.y()) * scale
-        << ' ';
-    }
+    for (const Vec3& p : v) s << X(p.x()) << ',' << Y(p.y()) << ' ';
     s << "'/>\n";
     return s.str();
   };
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write the plot");
-  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << size << "' height='" << size + 30
-    << "'>\n<rect width='100%' height='100%' fill='white'/>\n"
-    << "<text x='10' y='20' font-family='sans-serif' font-size='14'>" << title
-    << " (top view; grey: ground truth, red: estimate; frame " << span << " m)</text>\n"
-    << polyline(ref, "#888888", 3) << polyline(est, "#d62728", 1.5) << "</svg>\n";
+  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << left + size + 30 << "' height='"
+    << top + size + 60 << "' font-family='sans-serif'>\n<rect width='100%' height='100%' "
+    << "fill='white'/>\n";
+  for (size_t i = 0; i < lines.size(); ++i) {
+    f << "<text x='10' y='" << 22 + 18 * i << "' font-size='14'>" << lines[i] << "</text>\n";
+  }
+  f << "<rect x='" << left << "' y='" << top << "' width='" << size << "' height='" << size
+    << "' fill='none' stroke='black'/>\n";
+  for (double v = std::ceil(lo.x() / step) * step; v <= lo.x() + span; v += step) {
+    f << "<text x='" << X(v) << "' y='" << top + size + 16 << "' font-size='11' "
+      << "text-anchor='middle'>" << (std::abs(v) < 1e-9 * step ? 0.0 : v) << "</text>\n";
+  }
+  for (double v = std::ceil(lo.y() / step) * step; v <= lo.y() + span; v += step) {
+    f << "<text x='" << left - 5 << "' y='" << Y(v) + 4 << "' font-size='11' "
+      << "text-anchor='end'>" << (std::abs(v) < 1e-9 * step ? 0.0 : v) << "</text>\n";
+  }
+  f << "<text x='" << left + size / 2 << "' y='" << top + size + 34
+    << "' font-size='12' text-anchor='middle'>x [m]</text>\n<text x='15' y='" << top + size / 2
+    << "' font-size='12'>y [m]</text>\n"
+    << polyline(ref, "#888888", 3) << polyline(est, "#d62728", 1.5) << "<text x='" << left + 10
+    << "' y='" << top + 18 << "' font-size='12' fill='#888888'>ground truth</text>\n<text x='"
+    << left + 10 << "' y='" << top + 34
+    << "' font-size='12' fill='#d62728'>estimate (scan poses, aligned)</text>\n</svg>\n";
 }
 
 void WriteScanLog(const std::string& path, const RunSummary& run) {
@@ -260,12 +286,22 @@ void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>
   f << std::setprecision(12);
   const Mat3 A = alignment.topLeftCorner<3, 3>();
   const Vec3 a = alignment.topRightCorner<3, 1>();
+  bool first = true;
+  Mat3 C_e0, C_t0;
   for (const io::StampedPose& e : estimate) {
     Vec3 p;
     Mat3 C;
     if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
+    if (first) {
+      C_e0 = e.pose.rotation();
+      C_t0 = C;
+      first = false;
+    }
     const Vec3 q = A * e.pose.translation() + a;
-    const double angle = Eigen::AngleAxisd(C.transpose() * A * e.pose.rotation()).angle();
+    // Rotation drift since the first pose: independent of the position-only alignment, which
+    // leaves the rotation free on a short, nearly straight path.
+    const Mat3 dC_truth = C_t0.transpose() * C, dC_est = C_e0.transpose() * e.pose.rotation();
+    const double angle = Eigen::AngleAxisd(dC_truth.transpose() * dC_est).angle();
     f << 1e-9 * double(e.t_ns) << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << p.x()
       << ',' << p.y() << ',' << p.z() << ',' << (q - p).norm() << ',' << angle * 180.0 / M_PI
       << '\n';

@@ -64,9 +64,9 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth);
 
 // Per-pose errors against the truth after `alignment` (estimate → truth frame), CSV:
-// t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg] (angle of
-// C_truthᵀ·C_align·C_est, truth rotation of the nearest truth pose). Poses outside the truth are
-// left out. Read by tools/plot_odometry.py.
+// t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg]: the angle of
+// the rotation drift since the first pose, (C_t0ᵀ C_t)ᵀ (C_e0ᵀ C_e), with the truth rotation of the
+// nearest truth pose. Poses outside the truth are left out. Read by tools/plot_odometry.py.
 void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
 
@@ -74,8 +74,8 @@ void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>
 // final cost, ms, position, message.
 void WriteScanLog(const std::string& path, const RunSummary& run);
 
-// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file: no
-// plotting dependency needed.
+// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file with
+// axes in metres and the title wrapped: the fallback when matplotlib is missing.
 void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment,
                      const std::string& title);
