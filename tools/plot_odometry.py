@@ -12,7 +12,8 @@ errors). Writes <method_dir>/odometry.png and, for several methods, <out_dir>/co
   * position error [cm] and rotation error [deg] over time;
   * per-scan run time [ms] over time, coloured by scan status; degenerate, IMU-gap and failed
     scans marked, gaps in the scan sequence shaded.
-Exit code 3 if matplotlib is missing (the caller then writes its SVG fallback).
+Exit code 3 if matplotlib is missing (the caller then writes its SVG fallback). CTLIO_PLOT_DPI
+sets the resolution (default 90).
 """
 import csv
 import os
@@ -118,8 +119,8 @@ def draw_views(ax_top, ax_side, runs, single):
                     label="ground truth", zorder=1)
         for k, run in enumerate(runs):
             colour = METHOD_COLOURS[k % len(METHOD_COLOURS)]
-            label = ("estimate (dense)" if run.dense else "estimate (scan poses)") if single \
-                else run.method
+            rate = "dense" if run.dense else "scan poses"
+            label = "estimate (%s)" % rate if single else "%s (%s)" % (run.method, rate)
             ax.plot([p[i - 1] for p in run.path], [p[j - 1] for p in run.path], color=colour,
                     lw=1.2, label=label, zorder=2)
             if single:
@@ -203,7 +204,7 @@ def figure(runs, title, path):
     draw_timing(axes[1][1], runs, single)
     # Wrapped so that a long source path never runs off the figure.
     fig.suptitle("\n".join(textwrap.wrap(title, 95)), fontsize=12)
-    fig.savefig(path, dpi=90)
+    fig.savefig(path, dpi=int(os.environ.get("CTLIO_PLOT_DPI", "90")))
     plt.close(fig)
     print("wrote " + path)
 
