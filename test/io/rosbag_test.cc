@@ -210,6 +210,37 @@ TEST(Rosbag, BadBagsAndLayoutsGiveClearErrors) {
   EXPECT_EQ(f.imu.size(), 10u);  // 10 ms … 100 ms ≤ the scan end (100 ms + 9 µs)
 }
 
+TEST(Rosbag, OdometryBagHoldsTheTrajectory) {
+  const fs::path d = testing::FreshTempDir("rosbag_odometry");
+  std::vector<StampedPose> trajectory;
+  for (int k = 1; k <= 5; ++k) {
+    const SE3 T(Eigen::AngleAxisd(0.3 * k, Vec3(1, 2, 3).normalized()).toRotationMatrix(),
+                Vec3(k, -0.5 * k, 0.1));
+    trajectory.push_back({int64_t(k) * 100'000'000, T});
+  }
+  const std::string path = (d / "trajectory.bag").string();
+  WriteOdometryBag(path, trajectory);
+  // Read back as ground truth: the reader takes nav_msgs/Odometry from a chosen topic.
+  rosbag::Bag bag(path, rosbag::bagmode::Append);
+  sensor_msgs::Imu imu;
+  imu.header.stamp = ros::Time(0.05);
+  bag.write("/imu", imu.header.stamp, imu);
+  sensor_msgs::PointCloud2 cloud = Cloud(
+      {{"x", kFloat32, 0, 1}, {"y", kFloat32, 4, 1}, {"z", kFloat32, 8, 1}, {"t", kUInt32, 12, 1}},
+      16);
+  bag.write("/points", ros::Time(0.2), cloud);
+  bag.close();
+  RosbagOptions o;
+  o.ground_truth_topic = "/ctlio/odometry";
+  const auto read = RosbagSource(path, o).GroundTruth();
+  ASSERT_TRUE(read);
+  ASSERT_EQ(read->size(), trajectory.size());
+  for (size_t k = 0; k < trajectory.size(); ++k) {
+    EXPECT_EQ((*read)[k].t_ns, trajectory[k].t_ns);
+    EXPECT_LT(((*read)[k].pose.Matrix() - trajectory[k].pose.Matrix()).norm(), 1e-12);
+  }
+}
+
 TEST(Rosbag, NoTimeFieldUsesTheAzimuth) {
   const fs::path d = testing::FreshTempDir("rosbag_azimuth");
   const PointField x{"x", kFloat32, 0, 1}, y{"y", kFloat32, 4, 1}, z{"z", kFloat32, 8, 1};

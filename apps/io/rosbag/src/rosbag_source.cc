@@ -243,9 +243,10 @@ uint64_t RosbagSource::bytes_read() const { return impl_->bytes; }
 
 SE3 RosbagSource::ImuFromLidar() const {
   if (impl_->extrinsic_origin.empty()) {
-    impl_->Fail("no lidar → IMU extrinsic: /tf_static does not connect '" + impl_->imu_frame +
-                "' and '" + impl_->lidar_frame +
-                "' and no preset applies; give `extrinsic:` in the config or --preset");
+    auto frame = [](const std::string& f) { return f.empty() ? "(no frame_id)" : "'" + f + "'"; };
+    impl_->Fail("no lidar → IMU extrinsic: /tf_static does not connect the IMU frame " +
+                frame(impl_->imu_frame) + " and the lidar frame " + frame(impl_->lidar_frame) +
+                " and no preset applies; give `extrinsic:` in the config or --preset");
   }
   return impl_->extrinsic;
 }
