@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -131,6 +132,21 @@ TEST(PointFields, LayoutErrorsNameTheFieldsFound) {
       {"no time field 'stamp_us'", "x:float32 y:float32 z:float32"});
   // No time field at all is not an error: the caller recovers the times from the azimuth.
   EXPECT_FALSE(DetectPointLayout({x, y, z, {"intensity", kFloat32, 12, 1}}, 16, {}, "").time);
+}
+
+TEST(PointFields, ATimeThatIsNotOneIsAnError) {
+  const std::vector<PointField> fields = {{"x", kFloat32, 0, 1},
+                                          {"y", kFloat32, 4, 1},
+                                          {"z", kFloat32, 8, 1},
+                                          {"timestamp", kFloat64, 12, 1}};
+  const PointLayout layout = DetectPointLayout(fields, 20, {}, "");
+  for (const double bad : {std::nan(""), 1e300, -1e11}) {
+    std::vector<uint8_t> data(40, 0);
+    std::memcpy(data.data() + 20 + 12, &bad, sizeof(bad));  // the second point
+    PointCloud c;
+    ExpectError([&] { DecodePoints(data.data(), 2, layout, 0, "cloud.pcd: ", &c); },
+                {"cloud.pcd: point 1", "time is not finite or outside int64 ns"});
+  }
 }
 
 TEST(PointFields, OverrideReadsAnUndocumentedField) {

@@ -260,26 +260,18 @@ bool PointTimeNs(const PointLayout& layout, const uint8_t* p, int64_t stamp_ns, 
   const PointField& f = *layout.time;
   const TimeConvention& c = layout.convention;
   const int64_t base = c.reference == TimeReference::kAbsolute ? 0 : stamp_ns;
+  int64_t v = 0;
   if (IsIntegerType(f.datatype) && c.unit == TimeUnit::kNanoseconds) {
-    // Exact: no detour through double for integer nanoseconds.
-    int64_t v = 0;
-    switch (f.datatype) {
-      case kUInt32: {
-        uint32_t u;
-        std::memcpy(&u, p + f.offset, sizeof(u));
-        v = u;
-        break;
-      }
-      default:
-        v = int64_t(ReadFieldValue(p + f.offset, f.datatype));
-    }
-    *t_ns = base + v;
-    return true;
+    // Exact: no detour through double for integer nanoseconds (every integer type fits in double
+    // exactly up to 32 bits).
+    v = int64_t(ReadFieldValue(p + f.offset, f.datatype));
+  } else {
+    const double ns = ReadFieldValue(p + f.offset, f.datatype) * UnitToNs(c.unit);
+    // Not finite or outside int64 nanoseconds (±292 years): not a time.
+    if (!(std::abs(ns) < 9.2e18)) return false;
+    v = std::llround(ns);
   }
-  const double v = ReadFieldValue(p + f.offset, f.datatype);
-  if (!std::isfinite(v)) return false;
-  *t_ns = base + std::llround(v * UnitToNs(c.unit));
-  return true;
+  return !__builtin_add_overflow(base, v, t_ns);
 }
 
 void DecodePoints(const uint8_t* data, size_t n, const PointLayout& layout, int64_t stamp_ns,
@@ -299,7 +291,8 @@ void DecodePoints(const uint8_t* data, size_t n, const PointLayout& layout, int6
     if (layout.time) {
       int64_t t = 0;
       if (!PointTimeNs(layout, p, stamp_ns, &t)) {
-        throw std::runtime_error(where + "point " + std::to_string(i) + ": non-finite time");
+        throw std::runtime_error(where + "point " + std::to_string(i) +
+                                 ": time is not finite or outside int64 ns");
       }
       out->times_ns.push_back(t);
     }

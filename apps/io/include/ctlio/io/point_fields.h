@@ -99,12 +99,13 @@ struct PointLayout {
 PointLayout DetectPointLayout(const std::vector<PointField>& fields, uint32_t point_step,
                               const TimeFieldOptions& options, const std::string& where);
 
-// The absolute time [ns] of the point stored at `p`; false if the stored value is not finite.
+// The absolute time [ns] of the point stored at `p`; false if the stored value is not finite or
+// the time does not fit int64 nanoseconds.
 bool PointTimeNs(const PointLayout& layout, const uint8_t* p, int64_t stamp_ns, int64_t* t_ns);
 
 // Appends `n` points stored `point_step` bytes apart (little-endian) to `out`: x/y/z, intensity,
 // ring and, when the layout has a time field, absolute times. Non-finite points are dropped and
-// counted; a non-finite time is an error naming `where` and the point index.
+// counted; a time that is not one (PointTimeNs) is an error naming `where` and the point index.
 void DecodePoints(const uint8_t* data, size_t n, const PointLayout& layout, int64_t stamp_ns,
                   const std::string& where, PointCloud* out);
 
