@@ -50,6 +50,7 @@ DEFINE_string(time_field, "", "Per-point time field (default: detected; 'none' =
 DEFINE_string(time_unit, "", "Override the time field's unit: s | ms | us | ns");
 DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | absolute");
 DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
+DEFINE_double(imu_accel_scale, 1.0, "rosbag: accelerometer scale (9.80665 for IMUs reporting g)");
 DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
@@ -85,6 +86,7 @@ std::unique_ptr<io::DataSource> OpenSource() {
     o.lidar_topic = FLAGS_lidar_topic;
     o.imu_topic = FLAGS_imu_topic;
     o.preset = FLAGS_preset;
+    o.accel_scale = FLAGS_imu_accel_scale;
     o.time.field = FLAGS_time_field;
     if (!FLAGS_time_unit.empty()) o.time.unit = io::ParseTimeUnit(FLAGS_time_unit);
     if (!FLAGS_time_reference.empty())

@@ -241,6 +241,23 @@ TEST(Rosbag, OdometryBagHoldsTheTrajectory) {
   }
 }
 
+TEST(Rosbag, AccelerometerScale) {
+  const fs::path d = testing::FreshTempDir("rosbag_accel");
+  const std::string path = (d / "g.bag").string();
+  WriteBag(path, {Cloud({{"x", kFloat32, 0, 1},
+                         {"y", kFloat32, 4, 1},
+                         {"z", kFloat32, 8, 1},
+                         {"t", kUInt32, 12, 1}},
+                        16)});
+  RosbagOptions o;
+  o.accel_scale = 9.80665 / 9.81;  // the fixture writes 9.81
+  RosbagSource s(path, o);
+  ScanFrame f;
+  ASSERT_TRUE(s.Next(&f));
+  ASSERT_FALSE(f.imu.empty());
+  EXPECT_NEAR(f.imu.front().accel.z(), 9.80665, 1e-12);
+}
+
 TEST(Rosbag, NoTimeFieldUsesTheAzimuth) {
   const fs::path d = testing::FreshTempDir("rosbag_azimuth");
   const PointField x{"x", kFloat32, 0, 1}, y{"y", kFloat32, 4, 1}, z{"z", kFloat32, 8, 1};

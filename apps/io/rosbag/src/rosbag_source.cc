@@ -142,6 +142,7 @@ struct RosbagSource::Impl {
   int64_t last_imu_ns = INT64_MIN, last_scan_start_ns = INT64_MIN;
   size_t duplicates = 0;
   uint64_t bytes = 0;
+  double accel_norm_sum = 0.0;
   bool azimuth_logged = false;
   SE3 extrinsic;
   std::string extrinsic_origin;  // empty: unknown
@@ -288,9 +289,20 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
   ImuSample s;
   s.t_ns = t;
   s.gyro = Vec3(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
-  s.accel = Vec3(m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
+  s.accel = options.accel_scale *
+            Vec3(m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
   if (!s.gyro.allFinite() || !s.accel.allFinite()) {
     throw std::runtime_error(Where(imu_topic, imu_messages) + "non-finite IMU sample");
+  }
+  // sensor_msgs/Imu is m/s², but some drivers publish g (Livox's built-in IMU): a mean specific
+  // force near 1 over the first samples is flagged once, with the remedy.
+  if (imu_messages <= 200) {
+    accel_norm_sum += s.accel.norm();
+    if (imu_messages == 200 && accel_norm_sum / 200 > 0.5 && accel_norm_sum / 200 < 1.5) {
+      LOG(WARNING) << path << ": " << imu_topic << ": mean |accelerometer| over the first 200 "
+                   << "samples is " << accel_norm_sum / 200 << ": the IMU seems to report g, not "
+                   << "m/s²; scale it with --imu_accel_scale=9.80665";
+    }
   }
   imu.push_back(s);
 }

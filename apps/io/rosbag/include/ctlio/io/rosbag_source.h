@@ -46,6 +46,9 @@ struct RosbagOptions {
   std::string preset;                  // empty: recognised from the topics (or none)
   TimeFieldOptions time;
   int64_t max_imu_gap_ns = 100'000'000;  // 0 = no check
+  // Multiplies the accelerometer: 9.80665 for IMUs that report g (Livox), whose mean specific
+  // force near 1 is warned about.
+  double accel_scale = 1.0;
   // Ground truth T_world_lidar read from this topic (nav_msgs/Odometry) when the bag has it.
   std::string ground_truth_topic = "/ground_truth";
 };
