@@ -217,8 +217,17 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
   const double raw_step = span / 5, mag = std::pow(10.0, std::floor(std::log10(raw_step)));
   const double step = raw_step / mag < 2 ? 2 * mag : raw_step / mag < 5 ? 5 * mag : 10 * mag;
   // Title wrapped into lines of at most 80 characters so that it is never cut off.
-  std::vector<std::string> lines;
-  for (size_t i = 0; i < title.size(); i += 80) lines.push_back(title.substr(i, 80));
+  std::vector<std::string> lines(1);
+  std::istringstream words(title);
+  for (std::string w; words >> w;) {
+    if (!lines.back().empty() && lines.back().size() + 1 + w.size() > 80) lines.emplace_back();
+    while (w.size() > 80) {  // a word longer than a line (a long path) is cut
+      lines.back() += w.substr(0, 80);
+      lines.emplace_back();
+      w.erase(0, 80);
+    }
+    lines.back() += (lines.back().empty() ? "" : " ") + w;
+  }
   const double left = 70, top = 30 + 18.0 * double(lines.size()), size = 520;
   const double scale = size / span;
   auto X = [&](double x) { return left + (x - lo.x()) * scale; };

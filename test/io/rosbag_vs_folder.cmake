@@ -1,7 +1,7 @@
 # End to end through the programs: the same short sparse simulated sequence written by
 # ctlio_simulate as a ctlio folder and as a ROS 1 bag, run by ctlio_odometry with the format
 # detected from the path, gives the same trajectory for Singer-LIO and the baseline; the bag run
-# logs that the extrinsic came from /tf_static.
+# logs that the extrinsic came from /tf_static and writes its (fallback) plots.
 #
 # Tolerance 1e-7 m, not 1e-9 m: the odometry's result depends on the heap layout at the 1e-9 m
 # level (the same folder run under GLIBC_TUNABLES=glibc.malloc.tcache_count=0 moved Singer-LIO by
@@ -26,14 +26,30 @@ foreach(layout ctlio rosbag)
   endif()
 endforeach()
 foreach(input folder run.bag)
+  # Plots only for the bag run, and there the SVG fallback (--python=false): matplotlib's import
+  # alone would take seconds (the PNG path is run by scripts/run_main.sh).
+  if(input STREQUAL "folder")
+    set(plot --plot=false)
+  else()
+    set(plot --python=false)
+  endif()
   execute_process(COMMAND ${ODO} --dataset=${OUT}/${input} --config=${CONFIG}
                           --method=singer_lio,imu_input --out=${OUT}/out_${input} --progress=false
+                          ${plot}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "ctlio_odometry on ${input} failed (${rc}):\n${log}")
   endif()
   if(input STREQUAL "run.bag" AND NOT log MATCHES "T_imu_lidar from the bag's /tf_static")
     message(FATAL_ERROR "the bag run did not take the extrinsic from /tf_static:\n${log}")
+  endif()
+endforeach()
+# The SVG top views with their wrapped title and metre axes.
+foreach(method singer_lio imu_input)
+  file(READ ${OUT}/out_run.bag/${method}/trajectory_topview.svg svg)
+  if(NOT svg MATCHES "${method} on rosbag:" OR NOT svg MATCHES "[0-9] cm<" OR
+     NOT svg MATCHES "x \\[m\\]")
+    message(FATAL_ERROR "${method}: the SVG top view lacks its title or axes")
   endif()
 endforeach()
 foreach(method singer_lio imu_input)
