@@ -24,6 +24,7 @@
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
 DEFINE_string(layout, "ctlio", "Layout: ctlio | newer_college | rosbag (a .bag file)");
+DEFINE_string(bag_compression, "none", "--layout rosbag: chunk compression none | lz4 | bz2");
 DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast");
 DEFINE_int32(index, 0, "Sequence index within the regime (the experiment uses 0..19)");
 DEFINE_uint64(seed, ctlio::sim::kExperimentSeed, "Experiment seed (documented default)");
@@ -105,6 +106,7 @@ int main(int argc, char** argv) {
     } else if (FLAGS_layout == "rosbag") {
       io::RosbagWriteOptions o;
       o.write_ground_truth = FLAGS_ground_truth;
+      o.compression = FLAGS_bag_compression;
       n = io::WriteRosbag(source, FLAGS_output, o, progress);
       if (FLAGS_ground_truth) {
         std::string stem = FLAGS_output;

@@ -1,9 +1,9 @@
-// ROS 1 bags (rosbag_source.h): the simulator written as a bag and read back (exact times, float32
-// points, IMU, extrinsic from /tf_static, ground truth), every driver's time field through a
-// PointCloud2 message, topic selection, and the bad inputs: a truncated or corrupted bag, a file
-// that is not a bag, missing or ambiguous topics, a PointCloud2 without x/y/z or with wrong field
-// types. No small real PointCloud2 + Imu bag is available offline, so all bags here are written by
-// the tests.
+// ROS 1 bags (rosbag_source.h): the simulator written as a bag (plain and LZ4-compressed) and read
+// back (exact times, float32 points, IMU, extrinsic from /tf_static, ground truth), every driver's
+// time field through a PointCloud2 message, topic selection, and the bad inputs: a truncated or
+// corrupted bag, a file that is not a bag, missing or ambiguous topics, a PointCloud2 without
+// x/y/z or with wrong field types. No small real PointCloud2 + Imu bag is available offline, so
+// all bags here are written by the tests.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
@@ -55,40 +55,46 @@ std::vector<ScanFrame> ReadAll(DataSource& s) {
 
 TEST(Rosbag, SimulatorRoundTripThroughABag) {
   const fs::path d = testing::FreshTempDir("rosbag_roundtrip");
-  const std::string bag = (d / "sim.bag").string();
-  sim::SimulatedSource written(SmallSim());
-  const size_t n = WriteRosbag(written, bag);
-  ASSERT_TRUE(IsRosbagFile(bag));
-  RosbagSource read(bag);
-  EXPECT_EQ(read.NumScans(), n);
-  EXPECT_EQ(read.lidar_topic(), "/os_cloud_node/points");  // the only PointCloud2 topic
-  // /tf_static connects os_imu and os_lidar and takes precedence over the 2021 preset, which the
-  // topic names match.
-  EXPECT_THAT(read.ExtrinsicOrigin(), HasSubstr("/tf_static"));
-  EXPECT_LT((read.ImuFromLidar().Matrix() - NewerCollegeImuFromLidar().Matrix()).norm(), 1e-15);
-  sim::SimulatedSource truth(SmallSim());
-  const auto a = ReadAll(read), b = ReadAll(truth);
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t k = 0; k < a.size(); ++k) {
-    EXPECT_EQ(a[k].start_ns, b[k].start_ns);
-    EXPECT_EQ(a[k].end_ns, b[k].end_ns);
-    ASSERT_EQ(a[k].cloud.size(), b[k].cloud.size());
-    EXPECT_EQ(a[k].cloud.times_ns, b[k].cloud.times_ns);
-    for (size_t i = 0; i < a[k].cloud.size(); ++i) {
-      EXPECT_LT((a[k].cloud.points[i] - b[k].cloud.points[i]).norm(), 1e-5);  // float32
+  for (const std::string compression : {"none", "lz4"}) {
+    SCOPED_TRACE(compression);
+    const std::string bag = (d / ("sim_" + compression + ".bag")).string();
+    sim::SimulatedSource written(SmallSim());
+    RosbagWriteOptions wo;
+    wo.compression = compression;
+    const size_t n = WriteRosbag(written, bag, wo);
+    ASSERT_TRUE(IsRosbagFile(bag));
+    RosbagSource read(bag);
+    EXPECT_EQ(read.NumScans(), n);
+    EXPECT_EQ(read.lidar_topic(), "/os_cloud_node/points");  // the only PointCloud2 topic
+    // /tf_static connects os_imu and os_lidar and takes precedence over the 2021 preset, which the
+    // topic names match.
+    EXPECT_THAT(read.ExtrinsicOrigin(), HasSubstr("/tf_static"));
+    EXPECT_LT((read.ImuFromLidar().Matrix() - NewerCollegeImuFromLidar().Matrix()).norm(), 1e-15);
+    sim::SimulatedSource truth(SmallSim());
+    const auto a = ReadAll(read), b = ReadAll(truth);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].start_ns, b[k].start_ns);
+      EXPECT_EQ(a[k].end_ns, b[k].end_ns);
+      ASSERT_EQ(a[k].cloud.size(), b[k].cloud.size());
+      EXPECT_EQ(a[k].cloud.times_ns, b[k].cloud.times_ns);
+      for (size_t i = 0; i < a[k].cloud.size(); ++i) {
+        EXPECT_LT((a[k].cloud.points[i] - b[k].cloud.points[i]).norm(), 1e-5);  // float32
+      }
+      ASSERT_EQ(a[k].imu.size(), b[k].imu.size()) << "scan " << k;
+      for (size_t i = 0; i < a[k].imu.size(); ++i) {
+        EXPECT_EQ(a[k].imu[i].t_ns, b[k].imu[i].t_ns);
+        EXPECT_EQ(a[k].imu[i].gyro, b[k].imu[i].gyro);  // float64 in the message: exact
+        EXPECT_EQ(a[k].imu[i].accel, b[k].imu[i].accel);
+      }
     }
-    ASSERT_EQ(a[k].imu.size(), b[k].imu.size()) << "scan " << k;
-    for (size_t i = 0; i < a[k].imu.size(); ++i) {
-      EXPECT_EQ(a[k].imu[i].t_ns, b[k].imu[i].t_ns);
-      EXPECT_EQ(a[k].imu[i].gyro, b[k].imu[i].gyro);  // float64 in the message: exact
-      EXPECT_EQ(a[k].imu[i].accel, b[k].imu[i].accel);
-    }
+    const auto gt = read.GroundTruth();
+    ASSERT_TRUE(gt);
+    ASSERT_EQ(gt->size(), truth.GroundTruth()->size());
+    EXPECT_LT(
+        (gt->back().pose.translation() - truth.GroundTruth()->back().pose.translation()).norm(),
+        1e-12);
   }
-  const auto gt = read.GroundTruth();
-  ASSERT_TRUE(gt);
-  ASSERT_EQ(gt->size(), truth.GroundTruth()->size());
-  EXPECT_LT((gt->back().pose.translation() - truth.GroundTruth()->back().pose.translation()).norm(),
-            1e-12);
 }
 
 TEST(Rosbag, EveryDriverTimeFieldRoundTripsThroughPointCloud2) {

@@ -53,6 +53,14 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
                    const std::function<void(size_t, size_t)>& progress) {
   try {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
+    if (options.compression == "lz4") {
+      bag.setCompression(rosbag::compression::LZ4);
+    } else if (options.compression == "bz2") {
+      bag.setCompression(rosbag::compression::BZ2);
+    } else if (options.compression != "none") {
+      throw std::runtime_error(path + ": unknown bag compression '" + options.compression +
+                               "' (none, lz4, bz2)");
+    }
     uint32_t point_step = 0;
     const std::vector<PointField> fields = OusterFields(&point_step);
     TimeConvention ouster;

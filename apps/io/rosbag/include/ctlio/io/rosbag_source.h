@@ -80,8 +80,9 @@ struct RosbagWriteOptions {
   std::string lidar_topic = "/os_cloud_node/points";  // ouster_ros names
   std::string imu_topic = "/os_cloud_node/imu";
   std::string lidar_frame = "os_lidar", imu_frame = "os_imu";
-  bool write_tf_static = true;     // imu_frame → lidar_frame = source.ImuFromLidar()
-  bool write_ground_truth = true;  // topic /ground_truth (nav_msgs/Odometry) if the source has it
+  bool write_tf_static = true;       // imu_frame → lidar_frame = source.ImuFromLidar()
+  bool write_ground_truth = true;    // topic /ground_truth (nav_msgs/Odometry) if the source has it
+  std::string compression = "none";  // chunk compression: none | lz4 | bz2 (read transparently)
 };
 
 // Writes any data source as a bag: each scan as an Ouster-style PointCloud2 (OusterFields, `t` =
