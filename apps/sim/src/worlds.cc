@@ -101,7 +101,7 @@ World BuildStreetWorld(const StreetParams& p, uint64_t seed) {
     const Vec3 out(u.y(), -u.x(), 0.0);  // right of the travel direction: outside the block
     for (const double sign : {1.0, -1.0}) {
       const Vec3 n = sign * out;
-      auto at = [&](double along, double lateral, double z) {
+      auto at = [&](double along, double lateral, double z) -> Vec3 {
         return A + along * u + lateral * n + Vec3(0, 0, z);
       };
       // Façades: buildings and gaps.
