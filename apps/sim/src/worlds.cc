@@ -170,8 +170,9 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
     view.min = view.min.cwiseMin(q);
     view.max = view.max.cwiseMax(q);
   }
-  view.min -= Vec3(40, 40, 0);
-  view.max += Vec3(40, 40, 0);
+  const Vec3 margin = Vec3(5, 5, 0) + 0.15 * (view.max - view.min).cwiseProduct(Vec3(1, 1, 0));
+  view.min -= margin;
+  view.max += margin;
   const double size = std::max(view.max.x() - view.min.x(), view.max.y() - view.min.y());
   const double px = 640.0 / size;
   auto X = [&](double x) { return (x - view.min.x()) * px; };
@@ -183,9 +184,9 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
   out << "<svg xmlns='http://www.w3.org/2000/svg' width='" << wpx << "' height='" << hpx + 24
       << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
          "fill='#f4f1e8'/>\n";
-  // Height field: cells of ~8 px, shaded by height.
+  // Height field: cells of ~18 px, shaded by height.
   for (const HeightField& f : s.fields) {
-    const int step = std::max(1, int(std::ceil(8.0 / (f.cell * px))));
+    const int step = std::max(1, int(std::ceil(18.0 / (f.cell * px))));
     double lo = 1e300, hi = -1e300;
     for (double z : f.z) lo = std::min(lo, z), hi = std::max(hi, z);
     for (int j = 0; j + step <= f.ny; j += step) {
@@ -203,26 +204,35 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
   std::vector<Box> boxes = s.boxes;
   std::sort(boxes.begin(), boxes.end(),
             [](const Box& a, const Box& b) { return a.max.z() < b.max.z(); });
+  auto visible = [&](const Vec3& lo, const Vec3& hi) {
+    return hi.x() > view.min.x() && lo.x() < view.max.x() && hi.y() > view.min.y() &&
+           lo.y() < view.max.y();
+  };
   for (const Box& b : boxes) {
+    if (!visible(b.min, b.max)) continue;
     const int g = std::clamp(int(200 - 4 * b.max.z()), 60, 200);
     out << "<rect x='" << X(b.min.x()) << "' y='" << Y(b.max.y()) << "' width='"
         << (b.max.x() - b.min.x()) * px << "' height='" << (b.max.y() - b.min.y()) * px
         << "' fill='rgb(" << g << ',' << g << ',' << g + 20
-        << ")' stroke='#333' stroke-width='0.3'/>\n";
+        << ")' fill-opacity='0.6' stroke='#333' stroke-width='0.3'/>\n";
   }
   for (const Sphere& c : s.spheres) {
+    if (!visible(c.centre, c.centre)) continue;
     out << "<circle cx='" << X(c.centre.x()) << "' cy='" << Y(c.centre.y()) << "' r='"
         << c.radius * px << "' fill='#3a7d3a' fill-opacity='0.6'/>\n";
   }
   for (const Cylinder& c : s.cylinders) {
+    if (!visible(c.base, c.base)) continue;
     out << "<circle cx='" << X(c.base.x()) << "' cy='" << Y(c.base.y()) << "' r='"
         << std::max(c.radius * px, 0.8) << "' fill='#5a3a1a'/>\n";
   }
   out << "<polygon fill='none' stroke='#d02020' stroke-width='1.2' points='";
-  for (const Vec3& q : world.path.ControlPoints()) out << X(q.x()) << ',' << Y(q.y()) << ' ';
-  out << "'/>\n<line x1='10' y1='" << hpx + 12 << "' x2='" << 10 + 50 * px << "' y2='" << hpx + 12
-      << "' stroke='black' stroke-width='2'/>\n<text x='" << 16 + 50 * px << "' y='" << hpx + 16
-      << "'>50 m   " << title << " (path in red)</text>\n</svg>\n";
+  const auto& path = world.path.ControlPoints();
+  for (size_t i = 0; i < path.size(); i += 4) out << X(path[i].x()) << ',' << Y(path[i].y()) << ' ';
+  const double scale = size > 150 ? 50.0 : 10.0;
+  out << "'/>\n<line x1='10' y1='" << hpx + 12 << "' x2='" << 10 + scale * px << "' y2='"
+      << hpx + 12 << "' stroke='black' stroke-width='2'/>\n<text x='" << 16 + scale * px << "' y='"
+      << hpx + 16 << "'>" << scale << " m   " << title << " (path in red)</text>\n</svg>\n";
 }
 
 }  // namespace ctlio::sim
