@@ -98,9 +98,28 @@ double HeightField::Height(double x, double y) const {
          Node(i, j + 1) * (1 - u) * v + Node(i + 1, j + 1) * u * v;
 }
 
-void HeightField::UpdateTop() { top = z.empty() ? -kInf : *std::max_element(z.begin(), z.end()); }
+void HeightField::UpdateTop() {
+  top = z.empty() ? -kInf : *std::max_element(z.begin(), z.end());
+  const int nbx = (nx + kBlock - 1) / kBlock, nby = (ny + kBlock - 1) / kBlock;
+  block_top.assign(size_t(std::max(nbx, 0)) * size_t(std::max(nby, 0)), -kInf);
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      // A node bounds the cells on both sides of a block edge.
+      for (int bj = std::max(0, (j - 1) / kBlock); bj <= std::min(nby - 1, j / kBlock); ++bj) {
+        for (int bi = std::max(0, (i - 1) / kBlock); bi <= std::min(nbx - 1, i / kBlock); ++bi) {
+          double& t = block_top[size_t(bj) * nbx + bi];
+          t = std::max(t, Node(i, j));
+        }
+      }
+    }
+  }
+}
 
 RayHit IntersectBox(const Box& b, const Vec3& o, const Vec3& d, double t_max) {
+  return IntersectBox(b, o, d, d.cwiseInverse(), t_max);
+}
+
+RayHit IntersectBox(const Box& b, const Vec3& o, const Vec3& d, const Vec3& inv_d, double t_max) {
   double t0 = 0.0, t1 = t_max;
   int axis = -1;
   for (int i = 0; i < 3; ++i) {
@@ -108,8 +127,7 @@ RayHit IntersectBox(const Box& b, const Vec3& o, const Vec3& d, double t_max) {
       if (o[i] < b.min[i] || o[i] > b.max[i]) return {};
       continue;
     }
-    const double inv = 1.0 / d[i];
-    double a = (b.min[i] - o[i]) * inv, c = (b.max[i] - o[i]) * inv;
+    double a = (b.min[i] - o[i]) * inv_d[i], c = (b.max[i] - o[i]) * inv_d[i];
     if (a > c) std::swap(a, c);
     if (a > t0) {
       t0 = a;
@@ -178,28 +196,42 @@ RayHit IntersectHeightField(const HeightField& f, const Vec3& o, const Vec3& d, 
   ClipZ(o, d, -kInf, f.top, &t0, &t1);
   const double t_first = t0;
   RayHit hit;
-  TraverseGrid(
-      f.x0, f.y0, f.cell, f.nx, f.ny, o, d, t0, t1, [&](int i, int j, double ta, double tb) {
-        const double h00 = f.Node(i, j), h10 = f.Node(i + 1, j), h01 = f.Node(i, j + 1),
-                     h11 = f.Node(i + 1, j + 1);
-        const double za = o.z() + ta * d.z(), zb = o.z() + tb * d.z();
-        if (std::min(za, zb) > std::max({h00, h10, h01, h11})) return false;
-        // Cell coordinates a, b ∈ [0, 1] along the ray, s = t − ta.
-        const double aa = (o.x() + ta * d.x() - f.x0) / f.cell - i, a1 = d.x() / f.cell;
-        const double ba = (o.y() + ta * d.y() - f.y0) / f.cell - j, b1 = d.y() / f.cell;
-        const double e1 = h10 - h00, e2 = h01 - h00, k = h00 - h10 - h01 + h11;
-        const double H0 = h00 + e1 * aa + e2 * ba + k * aa * ba;
-        const double H1 = e1 * a1 + e2 * b1 + k * (aa * b1 + ba * a1);
-        const double H2 = k * a1 * b1;
-        // Below the surface at a later cell's entry: the crossing fell on the shared edge.
-        const double s =
-            za < H0 ? (ta > t_first ? 0.0 : NAN) : EnteringRoot(-H2, d.z() - H1, za - H0, tb - ta);
-        if (std::isnan(s)) return false;
-        hit.t = ta + s;
-        const double a = aa + s * a1, b = ba + s * b1;
-        hit.normal = Vec3(-(e1 + k * b) / f.cell, -(e2 + k * a) / f.cell, 1.0).normalized();
-        return true;
-      });
+  auto cell = [&](int i, int j, double ta, double tb) {
+    const double h00 = f.Node(i, j), h10 = f.Node(i + 1, j), h01 = f.Node(i, j + 1),
+                 h11 = f.Node(i + 1, j + 1);
+    const double za = o.z() + ta * d.z(), zb = o.z() + tb * d.z();
+    if (std::min(za, zb) > std::max({h00, h10, h01, h11})) return false;
+    // Cell coordinates a, b ∈ [0, 1] along the ray, s = t − ta.
+    const double aa = (o.x() + ta * d.x() - f.x0) / f.cell - i, a1 = d.x() / f.cell;
+    const double ba = (o.y() + ta * d.y() - f.y0) / f.cell - j, b1 = d.y() / f.cell;
+    const double e1 = h10 - h00, e2 = h01 - h00, k = h00 - h10 - h01 + h11;
+    const double H0 = h00 + e1 * aa + e2 * ba + k * aa * ba;
+    const double H1 = e1 * a1 + e2 * b1 + k * (aa * b1 + ba * a1);
+    const double H2 = k * a1 * b1;
+    // Below the surface at a later cell's entry: the crossing fell on the shared edge.
+    const double s =
+        za < H0 ? (ta > t_first ? 0.0 : NAN) : EnteringRoot(-H2, d.z() - H1, za - H0, tb - ta);
+    if (std::isnan(s)) return false;
+    hit.t = ta + s;
+    const double a = aa + s * a1, b = ba + s * b1;
+    hit.normal = Vec3(-(e1 + k * b) / f.cell, -(e2 + k * a) / f.cell, 1.0).normalized();
+    return true;
+  };
+  // Blocks of kBlock × kBlock cells whose highest node is below the ray are skipped whole.
+  const int B = HeightField::kBlock;
+  const int nbx = (f.nx + B - 1) / B, nby = (f.ny + B - 1) / B;
+  TraverseGrid(f.x0, f.y0, B * f.cell, nbx, nby, o, d, t0, t1,
+               [&](int bi, int bj, double ta, double tb) {
+                 const double za = o.z() + ta * d.z(), zb = o.z() + tb * d.z();
+                 if (std::min(za, zb) > f.block_top[size_t(bj) * nbx + bi]) return false;
+                 bool found = false;
+                 TraverseGrid(f.x0 + bi * B * f.cell, f.y0 + bj * B * f.cell, f.cell,
+                              std::min(B, f.nx - bi * B), std::min(B, f.ny - bj * B), o, d, ta, tb,
+                              [&](int i, int j, double ca, double cb) {
+                                return found = cell(bi * B + i, bj * B + j, ca, cb);
+                              });
+                 return found;
+               });
   if (hit.t <= 0.0) return {};
   return hit;
 }
@@ -226,6 +258,7 @@ void Scene::Build(double cell) {
   for (uint32_t i = 0; i < cylinders.size(); ++i) all.push_back({kCylinder, i});
   for (uint32_t i = 0; i < spheres.size(); ++i) all.push_back({kSphere, i});
   refs_.clear();
+  large_.clear();
   cell_start_.assign(1, 0);
   nx_ = ny_ = 0;
   if (all.empty()) return;
@@ -243,6 +276,20 @@ void Scene::Build(double cell) {
     *j0 = std::clamp(int(std::floor((b.min.y() - bounds_.min.y()) / cell_)), 0, ny_ - 1);
     *j1 = std::clamp(int(std::floor((b.max.y() - bounds_.min.y()) / cell_)), 0, ny_ - 1);
   };
+  // The few primitives spanning many cells (an indoor storey's slab, long walls) are tested once
+  // per ray instead of once per cell crossed.
+  auto cells = [&](const Ref& r) {
+    int i0, i1, j0, j1;
+    cell_range(xy_bounds(r), &i0, &i1, &j0, &j1);
+    return (i1 - i0 + 1) * (j1 - j0 + 1);
+  };
+  std::stable_sort(all.begin(), all.end(),
+                   [&](const Ref& a, const Ref& b) { return cells(a) > cells(b); });
+  large_.clear();
+  while (!all.empty() && large_.size() < 8 && cells(all.front()) > 64) {
+    large_.push_back(all.front());
+    all.erase(all.begin());
+  }
   std::vector<uint32_t> count(size_t(nx_) * size_t(ny_) + 1, 0);
   for (const Ref& r : all) {
     int i0, i1, j0, j1;
@@ -261,10 +308,11 @@ void Scene::Build(double cell) {
   }
 }
 
-RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, double t_max) const {
+RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
+                           double t_max) const {
   switch (r.kind) {
     case kBox:
-      return IntersectBox(boxes[r.index], o, d, t_max);
+      return IntersectBox(boxes[r.index], o, d, inv_d, t_max);
     case kCylinder:
       return IntersectCylinder(cylinders[r.index], o, d, t_max);
     default:
@@ -284,6 +332,8 @@ RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
     if (d.z() > 0.0 && o.z() < z) keep({(z - o.z()) / d.z(), Vec3(0, 0, -1)});
   }
   for (const HeightField& f : fields) keep(IntersectHeightField(f, o, d, std::min(t_max, best.t)));
+  const Vec3 inv_d = d.cwiseInverse();
+  for (const Ref& r : large_) keep(IntersectRef(r, o, d, inv_d, best.t));
   if (refs_.empty()) return best;
   double t0 = 0.0, t1 = std::min(t_max, best.t);
   ClipXY(o, d, bounds_.min.x(), bounds_.min.y(), bounds_.max.x(), bounds_.max.y(), &t0, &t1);
@@ -292,7 +342,7 @@ RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
                [&](int i, int j, double, double tb) {
                  const size_t c = size_t(j) * nx_ + i;
                  for (uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
-                   keep(IntersectRef(refs_[k], o, d, best.t));
+                   keep(IntersectRef(refs_[k], o, d, inv_d, best.t));
                  }
                  return best.t <= tb;
                });

@@ -132,8 +132,9 @@ World BuildIndoorWorld(const IndoorParams& p, uint64_t seed) {
   const double tread = p.stair_run / p.steps, rise = F / p.steps;
   for (const double xc : {xw, xe}) {
     for (int k = 0; k < p.steps; ++k) {
+      // Step k: its tread and the solid below it (the flight is their union).
       box(Vec3(xc - 0.5 * p.stair_width, y0 + k * tread, 0),
-          Vec3(xc + 0.5 * p.stair_width, y1, (k + 1) * rise));
+          Vec3(xc + 0.5 * p.stair_width, y0 + (k + 1) * tread, (k + 1) * rise));
     }
     box(Vec3(xc - 0.5 * H, y1, st), Vec3(xc + 0.5 * H, 2 * D + t, F));
   }

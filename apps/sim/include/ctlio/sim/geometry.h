@@ -48,6 +48,8 @@ struct HeightField {
   int nx = 0, ny = 0;                                    // cells; (nx + 1) × (ny + 1) nodes
   std::vector<double> z;                                 // node (i, j) at z[j * (nx + 1) + i]
   double top = std::numeric_limits<double>::infinity();  // max of z: UpdateTop() after filling
+  static constexpr int kBlock = 8;
+  std::vector<double> block_top;  // max of z over each kBlock × kBlock block of cells
   void UpdateTop();
   double Node(int i, int j) const { return z[size_t(j) * size_t(nx + 1) + size_t(i)]; }
   double Height(double x, double y) const;  // bilinear; NaN outside the extent
@@ -55,6 +57,8 @@ struct HeightField {
 
 // Entry hits along o + t·d (d unit) with t ∈ (0, t_max); RayHit::t = +inf when none.
 RayHit IntersectBox(const Box& b, const Vec3& o, const Vec3& d, double t_max);
+// The same with the ray's componentwise inverse direction precomputed (one per ray, not per box).
+RayHit IntersectBox(const Box& b, const Vec3& o, const Vec3& d, const Vec3& inv_d, double t_max);
 RayHit IntersectCylinder(const Cylinder& c, const Vec3& o, const Vec3& d, double t_max);
 RayHit IntersectSphere(const Sphere& s, const Vec3& o, const Vec3& d, double t_max);
 RayHit IntersectHeightField(const HeightField& h, const Vec3& o, const Vec3& d, double t_max);
@@ -87,7 +91,9 @@ class Scene {
   int nx_ = 0, ny_ = 0;
   std::vector<uint32_t> cell_start_;  // CSR: refs of cell c are refs_[cell_start_[c] ...)
   std::vector<Ref> refs_;
-  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, double t_max) const;
+  std::vector<Ref> large_;  // tested once per ray, not binned
+  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
+                      double t_max) const;
 };
 
 }  // namespace ctlio::sim
