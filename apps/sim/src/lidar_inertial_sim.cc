@@ -200,24 +200,8 @@ double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
     if (d[i] > 0) r = std::min(r, (R.max[i] - o[i]) / d[i]);
     if (d[i] < 0) r = std::min(r, (R.min[i] - o[i]) / d[i]);
   }
-  // Obstacles: slab test, entry distance.
-  for (const Box& b : R.obstacles) {
-    double t0 = 0.0, t1 = r;
-    bool hit = true;
-    for (int i = 0; i < 3 && hit; ++i) {
-      if (d[i] == 0.0) {
-        hit = o[i] >= b.min[i] && o[i] <= b.max[i];
-        continue;
-      }
-      const double inv = 1.0 / d[i];
-      double a = (b.min[i] - o[i]) * inv, c = (b.max[i] - o[i]) * inv;
-      if (a > c) std::swap(a, c);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, c);
-      hit = t0 <= t1;
-    }
-    if (hit && t0 > 0.0) r = std::min(r, t0);
-  }
+  // Obstacles: entry distance (slab test).
+  for (const Box& b : R.obstacles) r = std::min(r, IntersectBox(b, o, d, r).t);
   return r;
 }
 
