@@ -183,5 +183,22 @@ TEST(LidarRealism, RangeDependentNoiseIncidenceAndBeamErrors) {
   EXPECT_GT(differ, int(p.size()) / 2);
 }
 
+TEST(Realism, InvalidOptionsAreRejected) {
+  auto bad = [](auto edit) {
+    SimConfig c = Small();
+    edit(c);
+    EXPECT_THROW(LidarInertialSim{c}, std::runtime_error);
+  };
+  bad([](SimConfig& c) { c.lidar.dropout = 1.5; });
+  bad([](SimConfig& c) { c.lidar.max_incidence_deg = 0.0; });
+  bad([](SimConfig& c) { c.lidar.reflect_range = -1.0; });
+  bad([](SimConfig& c) { c.imu.gyro_limit = -1.0; });
+  bad([](SimConfig& c) {
+    c.imu.outage_rate = 1.0;
+    c.imu.outage_length_min = 2.0;
+    c.imu.outage_length_max = 1.0;
+  });
+}
+
 }  // namespace
 }  // namespace ctlio::sim

@@ -24,6 +24,16 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
       config_.imu.rate_hz <= 0 || config_.duration_s <= 0 || config_.integration_step_s <= 0) {
     throw std::runtime_error("LidarInertialSim: invalid configuration (non-positive rate/count)");
   }
+  const auto& I = config_.imu;
+  if (L.dropout < 0 || L.dropout > 1 || L.max_incidence_deg <= 0 || L.max_incidence_deg > 90 ||
+      L.reflect_range < 0 || L.range_noise_per_m < 0 || L.elevation_error_deg < 0 ||
+      L.azimuth_error_deg < 0 || I.accel_limit < 0 || I.gyro_limit < 0 || I.outage_rate < 0 ||
+      (I.outage_rate > 0 &&
+       !(I.outage_length_min > 0 && I.outage_length_min <= I.outage_length_max))) {
+    throw std::runtime_error(
+        "LidarInertialSim: invalid realism option (dropout in [0, 1], incidence in (0, 90] deg, "
+        "ranges, errors, limits and rates ≥ 0, 0 < outage length min ≤ max)");
+  }
   world_ = BuildWorld(config_.world, config_.room);
   const bool guided = config_.motion.guided;
   if (guided && PeakSpeed(config_.motion.guide) > world_.max_speed) {
@@ -45,7 +55,6 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xC7u};
   std::mt19937_64 rng(seq);
   std::normal_distribution<double> normal;
-  const auto& I = config_.imu;
   const int64_t dt_ns = PeriodNs(I.rate_hz);
   const double dt = 1e-9 * double(dt_ns);
   const int64_t end_ns = config_.start_ns + std::llround(config_.duration_s * 1e9);
