@@ -78,8 +78,8 @@ TEST(StatePriorTest, ResidualAndJacobians) {
 TEST(UnaryPriorTest, RejectsNonPositiveDefiniteCovariance) {
   Mat6 cov = Mat6::Identity();
   cov(2, 2) = -1.0;
-  EXPECT_THROW(PosePrior::FromCovariance(SE3(), cov), std::runtime_error);
-  EXPECT_THROW(VelocityPrior::FromCovariance(Vec6::Zero(), cov), std::runtime_error);
+  EXPECT_THROW(PosePrior::FromCovariance(SE3(), cov), std::invalid_argument);
+  EXPECT_THROW(VelocityPrior::FromCovariance(Vec6::Zero(), cov), std::invalid_argument);
 }
 
 }  // namespace
