@@ -13,12 +13,10 @@
 
 #include "common/gradient_check.h"
 #include "ctlio/factors/gp/se3_jacobian_derivative.h"
-#include "gp_test_util.h"
 
 namespace ctlio::gp {
 namespace {
 
-using ctlio::gp::testing::JacobiansMatchNumericScaled;
 using ctlio::testing::PoseParameters;
 using ctlio::testing::RandomPose;
 using ctlio::testing::RandomVec6;
@@ -236,9 +234,9 @@ TEST(GpInterpolatorTest, JacobiansMatchNumeric) {
       const std::vector<const double*> p{K.p0.data(), K.v0.data(), K.a0.data(),
                                          K.p1.data(), K.v1.data(), K.a1.data()};
       InterpolatedStateCost state_cost(interp, x.pose);
-      EXPECT_TRUE(JacobiansMatchNumericScaled(state_cost, m, p, 1e-8)) << c.name;
+      EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(state_cost, m, p, 1e-8)) << c.name;
       InterpolatedPoseCost pose_cost(interp, x.pose);
-      EXPECT_TRUE(JacobiansMatchNumericScaled(pose_cost, m, p, 1e-8)) << c.name;
+      EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(pose_cost, m, p, 1e-8)) << c.name;
       // Pose() and State() agree.
       SE3 T;
       PoseJacobian Jp0, Jp1;
@@ -261,8 +259,8 @@ TEST(GpExtrapolatorTest, JacobiansMatchNumeric) {
     KnotState x;
     ex.State(K.k, &x, nullptr);
     ExtrapolatedStateCost cost(ex, x.pose);
-    EXPECT_TRUE(JacobiansMatchNumericScaled(cost, {&kPoseManifold, nullptr, nullptr},
-                                            {K.p0.data(), K.v0.data(), K.a0.data()}, 1e-8))
+    EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(
+        cost, {&kPoseManifold, nullptr, nullptr}, {K.p0.data(), K.v0.data(), K.a0.data()}, 1e-8))
         << c.name;
     SE3 T;
     PoseJacobian Jp;
@@ -451,7 +449,8 @@ TEST(GpInterpolatorRowsTest, SelectedRowsMatchNumeric) {
       for (const unsigned mask : RowMasks()) {
         if (mask == kTranslationRows) continue;  // no residual without the rotation part
         SelectedRowsCost cost(interp, x.pose, mask & ~kTranslationRows);
-        EXPECT_TRUE(JacobiansMatchNumericScaled(cost, m, p, 1e-8)) << c.name << " mask " << mask;
+        EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(cost, m, p, 1e-8))
+            << c.name << " mask " << mask;
       }
     }
   }
