@@ -1,4 +1,4 @@
-// The paper's question on real data (issue 5): fuse the real EuRoC V1_01 IMU
+// The paper's question on real data (SPEC §7): fuse the real EuRoC V1_01 IMU
 // with ground-truth positions subsampled to 10 Hz plus Gaussian noise (fixed
 // seed), four ways, in batch:
 //   (1) IMU as an input: Forster preintegration between the position times;

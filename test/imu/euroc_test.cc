@@ -164,7 +164,8 @@ TEST(EurocData, GravityInitializationRecoversRollPitch) {
     EXPECT_NEAR(delta.z(), 0.0, 1e-12);
     EXPECT_LT(std::abs(delta.x() - log_error.x()), 0.02);
     EXPECT_LT(std::abs(delta.y() - log_error.y()), 0.02);
-    // The requirement: roll and pitch (about the world axes) and the tilt within 1°.
+    // Required of a still-start initialisation: roll and pitch (about the world axes) and the
+    // tilt within 1°.
     EXPECT_LT(std::abs(delta.x()), 1.0);
     EXPECT_LT(std::abs(delta.y()), 1.0);
     EXPECT_LT(tilt, 1.0);
