@@ -57,6 +57,7 @@
 #include "ctlio/factors/imu/bias_factors.h"
 #include "ctlio/factors/imu/gravity_initialization.h"
 #include "ctlio/factors/imu/imu_data.h"
+#include "ctlio/io/euroc.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/factors/imu/preintegrated_imu.h"
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
@@ -87,6 +88,10 @@ DEFINE_double(alpha_rot, 10.0, "Singer rotational alpha when --skip_fit");
 
 namespace ctlio::imu {
 namespace {
+
+using io::GroundTruthState;
+using io::ReadEurocImuCsv;
+using io::ReadVicon2gtCsv;
 
 constexpr double kG = 9.81;
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
