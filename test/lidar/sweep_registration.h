@@ -77,7 +77,7 @@ inline RegistrationSummary RegisterContinuous(const VoxelMap& map,
     window.AddVectorState(keys.acceleration, x->acceleration);
   }
   window.AddResidualBlock(new gp::SingerPrior(model, t_k1 - t_k), nullptr, KnotPair(a, b));
-  ContinuousLidarTerm term(model, t_k, t_k1, a, b, keypoints, window);
+  ContinuousLidarTerm term(model, t_k, t_k1, a, b, keypoints, &window);
   const RegistrationSummary summary =
       ScanRegistration(options, OdometryConfig().min_associations).Register(map, &term, &window);
   *k = gp::ReadKnotState(window.State(a.pose), window.State(a.velocity),

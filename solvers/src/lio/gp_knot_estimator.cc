@@ -139,7 +139,7 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
   const Knot& prev = knots_[knots_.size() - 2];
   const Knot& k = knots_.back();
   return std::make_unique<ContinuousLidarTerm>(model_, prev.t, k.t, prev.keys, k.keys,
-                                               scan.keypoints, *window);
+                                               scan.keypoints, window);
 }
 
 std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {

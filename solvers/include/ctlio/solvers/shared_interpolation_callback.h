@@ -3,9 +3,9 @@
 // PrepareForEvaluation, and this callback interpolates each registered firing once
 // (SharedPoseInterpolation::Prepare) for all the point-to-plane residuals that share it.
 //
-// Firings are registered when their first residual is created and held weakly: a firing whose
-// residuals have all been removed (the next association round, or marginalisation) expires and
-// is dropped here, so only interpolations some residual reads are computed.
+// Firings are held weakly: one whose residuals have all been removed (marginalisation) expires
+// and is dropped here. Only active firings (some residual reads them) are prepared, and each only
+// when the knots moved since its last preparation.
 #pragma once
 
 #include <ceres/evaluation_callback.h>
@@ -22,19 +22,19 @@ class SharedInterpolationCallback final : public ceres::EvaluationCallback {
  public:
   void Add(const std::shared_ptr<SharedPoseInterpolation>& firing) { firings_.push_back(firing); }
 
-  // evaluate_jacobians is not needed: Prepare always forms the Jacobians too. A repeated point
-  // (new_evaluation_point == false) only prepares the firings added since.
-  void PrepareForEvaluation(bool /*evaluate_jacobians*/, bool new_evaluation_point) override {
+  // The flags are not needed: Prepare always forms the Jacobians too, and skips a firing whose
+  // knots have not moved since it was last prepared.
+  void PrepareForEvaluation(bool /*evaluate_jacobians*/, bool /*new_evaluation_point*/) override {
     firings_.erase(
         std::remove_if(firings_.begin(), firings_.end(), [](const auto& f) { return f.expired(); }),
         firings_.end());
     for (const auto& weak : firings_) {
       const std::shared_ptr<SharedPoseInterpolation> f = weak.lock();
-      if (new_evaluation_point || !f->prepared()) f->Prepare();
+      if (f->active()) f->Prepare();
     }
   }
 
-  // Live firings (those with at least one residual).
+  // Live firings (those some residual or their owner still holds).
   size_t size() const {
     return static_cast<size_t>(std::count_if(firings_.begin(), firings_.end(),
                                              [](const auto& f) { return !f.expired(); }));

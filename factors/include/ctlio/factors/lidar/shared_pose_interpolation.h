@@ -39,9 +39,11 @@ class SharedPoseInterpolation {
       : interpolator_(std::move(interpolator)), knots_(knots) {}
 
   // Interpolation (with both Jacobians: after a trust-region step is accepted Ceres asks for the
-  // Jacobians at the point whose cost it just evaluated) at the values now in the knot blocks.
+  // Jacobians at the point whose cost it just evaluated) at the values now in the knot blocks;
+  // nothing to do if it was prepared at exactly these values already (e.g. the solve ended at
+  // the point the marginalisation then linearises at).
   void Prepare() {
-    if (knots_[0] == nullptr) return;
+    if (knots_[0] == nullptr || PreparedAt(knots_.data())) return;
     for (int b = 0, o = 0; b < 6; o += kSizes[b], ++b) {
       std::memcpy(values_.data() + o, knots_[b], kSizes[b] * sizeof(double));
     }
@@ -50,6 +52,12 @@ class SharedPoseInterpolation {
     prepared_ = true;
   }
   bool prepared() const { return prepared_; }
+  // T(τ) of the last Prepare().
+  const SE3& pose() const { return T_; }
+
+  // Whether any residual reads this interpolation now (an evaluation callback skips it if not).
+  bool active() const { return active_; }
+  void set_active(bool active) { active_ = active; }
 
   // T(τ) and the Jacobians (each may be null) at `parameters` (the six knot blocks' values, in
   // the order above): the prepared result if it was prepared at exactly these values, otherwise
@@ -89,6 +97,7 @@ class SharedPoseInterpolation {
   std::shared_ptr<const gp::GpInterpolator> interpolator_;
   KnotBlocks knots_;
   bool prepared_ = false;
+  bool active_ = true;
   std::array<double, kValues> values_{};
   SE3 T_;
   gp::PoseJacobian J_k_, J_k1_;
