@@ -7,7 +7,8 @@
 //    start|end])
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
 //
-// Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`),
+// Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
+// --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
 // alignment) and DIR/pose_errors.csv. Plots (tools/plot_odometry.py, python3-matplotlib):
@@ -53,6 +54,9 @@ DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end
 DEFINE_double(imu_accel_scale, 1.0, "rosbag: accelerometer scale (9.80665 for IMUs reporting g)");
 DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
+DEFINE_double(trajectory_rate, 0.0,
+              "Also write trajectory_dense.tum, the estimate at this rate [Hz] between the scan "
+              "poses (Singer-LIO: GP interpolation; baseline: IMU propagation); 0 = off");
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
@@ -168,6 +172,7 @@ int main(int argc, char** argv) {
       lioapp::RunOptions options;
       options.max_scans = static_cast<size_t>(std::max(0, FLAGS_max_scans));
       options.extrinsic_from_config = config_extrinsic;
+      options.trajectory_rate_hz = FLAGS_trajectory_rate;
       if (FLAGS_progress) {
         options.progress = [&m](size_t done, size_t total, const lio::ScanResult& r) {
           std::fprintf(stderr, "\r[%s] scan %zu/%zu  %-12s %5d assoc  %6.1f ms   ", m.c_str(), done,
@@ -182,6 +187,7 @@ int main(int argc, char** argv) {
       lioapp::RunSummary run = lioapp::RunOdometry(*source, config, options);
       if (FLAGS_progress) std::fprintf(stderr, "\n");
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
+      if (!run.dense.empty()) io::WriteTum(out + "/trajectory_dense.tum", run.dense);
       lioapp::WriteScanLog(out + "/scans.log", run);
       std::ofstream ev(out + "/evaluation.txt");
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
@@ -196,6 +202,10 @@ int main(int argc, char** argv) {
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
+        if (!run.dense.empty()) {
+          ev << "dense_ate_rmse_m " << lioapp::EvaluateAte(run.dense, *source->GroundTruth()).rmse
+             << "\ndense_poses " << run.dense.size() << "\n";
+        }
         ev << "ate_alignment";
         for (int r = 0; r < 4; ++r) {
           for (int c = 0; c < 4; ++c)

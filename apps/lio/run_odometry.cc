@@ -147,6 +147,11 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     if (r.status != lio::ScanStatus::kFailed) {
       run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
+      if (options.trajectory_rate_hz > 0.0) {
+        auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
+        if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
+        for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_imu_lidar});
+      }
     }
     run.scans.push_back(r);
     if (options.progress) options.progress(done, total, r);

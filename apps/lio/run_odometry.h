@@ -21,6 +21,8 @@ struct RunOptions {
   // otherwise the source's (a bag's /tf_static, then a dataset preset or the dataset's files; see
   // DataSource::ExtrinsicOrigin). The choice is logged and kept in RunSummary::extrinsic_origin.
   bool extrinsic_from_config = false;
+  // > 0: also sample the estimate at this rate between the scan poses (RunSummary::dense).
+  double trajectory_rate_hz = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
 };
@@ -40,6 +42,9 @@ struct RunSummary {
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
   // estimated (failed scans are left out, never written as garbage).
   std::vector<io::StampedPose> trajectory;
+  // With RunOptions::trajectory_rate_hz: T_world_lidar at that rate (LioOdometry::
+  // SampleNewestInterval after every estimated scan), ending at each scan pose.
+  std::vector<io::StampedPose> dense;
   std::vector<lio::ScanResult> scans;
   int failed = 0, degenerate = 0, imu_gaps = 0;
   std::string first_failure;                           // message of the first failed scan
