@@ -11,6 +11,6 @@ cmake --build build -j"$(nproc)"
 out=${CTLIO_MAIN_OUT:-out/main_job}
 ./build/apps/lio/ctlio_odometry --format sim --sim_regime medium --sim_index 0 \
   --sim_duration 3 \
-  --method singer_lio,imu_input --config data/sim_lio.yaml --out "$out"
+  --method singer_lio,imu_input --config data/sim_lio.yaml --out "$out" --trajectory_rate 200
 echo "main job: plots in $out/comparison.png, $out/singer_lio/odometry.png and" \
      "$out/imu_input/odometry.png (SVG top views instead if matplotlib is missing)"
