@@ -1,18 +1,27 @@
 // ctlio_odometry: lidar-inertial odometry on a dataset folder or on the in-memory simulator.
 //
-//   ctlio_odometry --dataset DIR --format newer_college|ctlio|kitti
+//   ctlio_odometry --dataset DIR|FILE.bag [--format newer_college|ctlio|kitti|rosbag]
 //                  --method singer_lio|imu_input|lidar_gyro|lidar_only --config FILE --out DIR
+//   (a ROS 1 bag: [--lidar_topic T --imu_topic T --preset newer_college_2020|newer_college_2021
+//    --time_field F --time_unit s|ms|us|ns --time_reference relative|absolute --stamp_at
+//    start|end])
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
 //
-// Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`),
+// Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
+// --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
-// alignment) with DIR/trajectory_topview.svg (estimate over ground truth). Several methods
-// separated by commas run one after the other and print their ATE side by side.
+// alignment) and DIR/pose_errors.csv. Plots (tools/plot_odometry.py, python3-matplotlib):
+// DIR/odometry.png (top and side view in metres, errors and per-scan time/status over time) and,
+// for several methods, DIR/comparison.png; without matplotlib an SVG top view
+// (trajectory_topview.svg) instead. Several methods separated by commas run one after the other
+// and print their ATE side by side.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -22,14 +31,33 @@
 
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
+#include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
 
-DEFINE_string(dataset, "", "Dataset folder (not used with --format sim)");
-DEFINE_string(format, "", "newer_college | ctlio | kitti | sim (default: detect from the folder)");
+DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
+DEFINE_string(
+    format, "",
+    "newer_college | ctlio | kitti | rosbag | sim (default: detect from the folder/file)");
+DEFINE_string(lidar_topic, "",
+              "rosbag: PointCloud2 topic (default: the only one, or the preset's)");
+DEFINE_string(imu_topic, "", "rosbag: Imu topic (default: the only one, or the preset's)");
+DEFINE_string(preset, "",
+              "rosbag: newer_college_2020 | newer_college_2021 (default: recognised from topics)");
+DEFINE_string(time_field, "", "Per-point time field (default: detected; 'none' = use the azimuth)");
+DEFINE_string(time_unit, "", "Override the time field's unit: s | ms | us | ns");
+DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | absolute");
+DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
+DEFINE_double(imu_accel_scale, 1.0, "rosbag: accelerometer scale (9.80665 for IMUs reporting g)");
+DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
+DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
+DEFINE_double(trajectory_rate, 0.0,
+              "Also write trajectory_dense.tum, the estimate at this rate [Hz] between the scan "
+              "poses (Singer-LIO: GP interpolation; baseline: IMU propagation); 0 = off");
+DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
 DEFINE_string(config, "", "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml)");
@@ -61,8 +89,23 @@ std::unique_ptr<io::DataSource> OpenSource() {
     return std::make_unique<sim::SimulatedSource>(c, name.str());
   }
   if (FLAGS_dataset.empty()) throw std::runtime_error("--dataset is required (or --format sim)");
+  if (FLAGS_format == "rosbag" || (FLAGS_format.empty() && io::IsRosbagFile(FLAGS_dataset))) {
+    io::RosbagOptions o;
+    o.lidar_topic = FLAGS_lidar_topic;
+    o.imu_topic = FLAGS_imu_topic;
+    o.preset = FLAGS_preset;
+    o.accel_scale = FLAGS_imu_accel_scale;
+    o.time.field = FLAGS_time_field;
+    if (!FLAGS_time_unit.empty()) o.time.unit = io::ParseTimeUnit(FLAGS_time_unit);
+    if (!FLAGS_time_reference.empty())
+      o.time.reference = io::ParseTimeReference(FLAGS_time_reference);
+    if (!FLAGS_stamp_at.empty()) o.time.stamp_at = io::ParseStampAt(FLAGS_stamp_at);
+    return std::make_unique<io::RosbagSource>(FLAGS_dataset, o);
+  }
   if (!std::filesystem::is_directory(FLAGS_dataset)) {
-    throw std::runtime_error(FLAGS_dataset + ": dataset folder does not exist");
+    throw std::runtime_error(FLAGS_dataset + (std::filesystem::exists(FLAGS_dataset)
+                                                  ? ": neither a dataset folder nor a ROS 1 bag"
+                                                  : ": dataset folder or bag does not exist"));
   }
   if (FLAGS_format.empty()) return io::OpenDataset(FLAGS_dataset);
   if (FLAGS_format == "newer_college")
@@ -70,7 +113,25 @@ std::unique_ptr<io::DataSource> OpenSource() {
   if (FLAGS_format == "ctlio") return std::make_unique<io::SimFolderReader>(FLAGS_dataset);
   if (FLAGS_format == "kitti") return std::make_unique<io::KittiReader>(FLAGS_dataset);
   throw std::runtime_error("unknown --format '" + FLAGS_format +
-                           "' (newer_college, ctlio, kitti, sim)");
+                           "' (newer_college, ctlio, kitti, rosbag, sim)");
+}
+
+#ifndef CTLIO_TOOLS_DIR
+#define CTLIO_TOOLS_DIR "tools"
+#endif
+
+// Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
+bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& folders) {
+  std::string python = FLAGS_python;
+  for (const char* p : {"python3", "/usr/bin/python3"}) {
+    if (!python.empty()) break;
+    const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
+    if (std::system(probe.c_str()) == 0) python = p;
+  }
+  if (python.empty()) return false;
+  std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
+  for (const std::string& f : folders) cmd += " '" + f + "'";
+  return std::system((cmd + " >/dev/null").c_str()) == 0;
 }
 
 std::vector<std::string> Split(const std::string& s) {
@@ -95,8 +156,13 @@ int main(int argc, char** argv) {
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
     if (!FLAGS_config.empty()) base = lio::LoadOdometryConfig(FLAGS_config);
+    // An `extrinsic:` written in the config wins over the dataset's (precedence in README).
+    const bool config_extrinsic =
+        !FLAGS_config.empty() && YAML::LoadFile(FLAGS_config)["extrinsic"].IsDefined();
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     std::vector<lioapp::RunSummary> runs;
+    std::vector<std::string> folders;
+    std::vector<std::vector<io::StampedPose>> truths;
     for (const std::string& m : methods) {
       lio::OdometryConfig config = base;
       config.method = lio::ParseLioMethod(m);
@@ -105,6 +171,8 @@ int main(int argc, char** argv) {
       std::filesystem::create_directories(out);
       lioapp::RunOptions options;
       options.max_scans = static_cast<size_t>(std::max(0, FLAGS_max_scans));
+      options.extrinsic_from_config = config_extrinsic;
+      options.trajectory_rate_hz = FLAGS_trajectory_rate;
       if (FLAGS_progress) {
         options.progress = [&m](size_t done, size_t total, const lio::ScanResult& r) {
           std::fprintf(stderr, "\r[%s] scan %zu/%zu  %-12s %5d assoc  %6.1f ms   ", m.c_str(), done,
@@ -119,6 +187,7 @@ int main(int argc, char** argv) {
       lioapp::RunSummary run = lioapp::RunOdometry(*source, config, options);
       if (FLAGS_progress) std::fprintf(stderr, "\n");
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
+      if (!run.dense.empty()) io::WriteTum(out + "/trajectory_dense.tum", run.dense);
       lioapp::WriteScanLog(out + "/scans.log", run);
       std::ofstream ev(out + "/evaluation.txt");
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
@@ -129,19 +198,42 @@ int main(int argc, char** argv) {
          << run.median_preprocess_ms << "\nmedian_associate_ms " << run.median_associate_ms
          << "\nmedian_solve_ms " << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
          << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
-         << run.peak_rss_kb / 1024.0 << "\n";
+         << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin << "\"\n";
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
+        if (!run.dense.empty()) {
+          ev << "dense_ate_rmse_m " << lioapp::EvaluateAte(run.dense, *source->GroundTruth()).rmse
+             << "\ndense_poses " << run.dense.size() << "\n";
+        }
+        ev << "ate_alignment";
+        for (int r = 0; r < 4; ++r) {
+          for (int c = 0; c < 4; ++c)
+            ev << ' ' << std::setprecision(17) << run.ate->alignment(r, c);
+        }
+        ev << std::setprecision(6) << "\n";
         io::WriteTum(out + "/ground_truth.tum", *source->GroundTruth());
-        char title[160];
-        std::snprintf(title, sizeof(title), "%s on %s: ATE %.4f m", run.method.c_str(),
-                      run.source.c_str(), run.ate->rmse);
-        lioapp::WriteTopViewSvg(out + "/trajectory_topview.svg", run.trajectory,
-                                *source->GroundTruth(), run.ate->alignment, title);
+        lioapp::WritePoseErrors(out + "/pose_errors.csv", run.trajectory, *source->GroundTruth(),
+                                run.ate->alignment);
+        truths.push_back(*source->GroundTruth());
+      } else {
+        truths.emplace_back();
       }
+      if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+      folders.push_back(out);
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       runs.push_back(std::move(run));
+    }
+    if (FLAGS_plot && !PlotWithMatplotlib(FLAGS_out, folders)) {
+      std::fprintf(stderr, "plots: no python3 with matplotlib, SVG top view instead\n");
+      for (size_t k = 0; k < runs.size(); ++k) {
+        if (!runs[k].ate) continue;
+        char title[240];
+        std::snprintf(title, sizeof(title), "%s on %s: ATE %.2f cm", runs[k].method.c_str(),
+                      runs[k].source.c_str(), 100.0 * runs[k].ate->rmse);
+        lioapp::WriteTopViewSvg(folders[k] + "/trajectory_topview.svg", runs[k].trajectory,
+                                truths[k], runs[k].ate->alignment, title);
+      }
     }
     std::printf("\n%-12s %8s %8s %8s %6s %6s %9s %9s %9s %9s %9s\n", "method", "ATE[m]", "mean[m]",
                 "max[m]", "failed", "degen", "med[ms]", "p95[ms]", "cpu_med", "cpu_p95", "peakMB");

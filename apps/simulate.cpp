@@ -1,5 +1,7 @@
 // ctlio_simulate: writes one sequence of the lidar-inertial simulator (SPEC §6) as a dataset
-// folder, in ctlio's own layout (default) or the Newer College 2020 layout, with ground truth.
+// folder, in ctlio's own layout (default) or the Newer College 2020 layout, with ground truth, or
+// as a ROS 1 bag (--layout rosbag: --output is the .bag file; ground truth on /ground_truth and in
+// <output without .bag>_ground_truth.tum).
 //
 //   ctlio_simulate --regime=fast --index=3 --output=/tmp/fast_03 [--layout=newer_college]
 //                  [--firing_decimation=4] [--duration=20] [--body_centric] [--pillars=4]
@@ -12,17 +14,21 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <random>
 #include <sstream>
 
 #include "ctlio/io/newer_college.h"
+#include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
+#include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
-DEFINE_string(layout, "ctlio", "Folder layout: ctlio | newer_college");
+DEFINE_string(layout, "ctlio", "Layout: ctlio | newer_college | rosbag (a .bag file)");
+DEFINE_string(bag_compression, "none", "--layout rosbag: chunk compression none | lz4 | bz2");
 DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | vehicle");
 DEFINE_string(world, "box", "World: box | street | corridor | park | indoor");
 DEFINE_uint64(world_seed, ctlio::sim::kExperimentSeed, "Seed of the world's geometry");
@@ -44,6 +50,9 @@ DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
 DEFINE_int32(index, 0, "Sequence index within the regime (the experiment uses 0..19)");
 DEFINE_uint64(seed, ctlio::sim::kExperimentSeed, "Experiment seed (documented default)");
 DEFINE_double(duration, 20.0, "Sequence length [s]");
+DEFINE_double(start_s, 0.0,
+              "Absolute time of the sequence start [s] (0 = 0, or 1 s for a bag: ROS 1 bags cannot "
+              "hold time 0)");
 DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resolution)");
 DEFINE_int32(beams, 128, "Lidar beams");
 DEFINE_bool(body_centric, false, "Generate the paper's body-centric accelerometer (no ω×v)");
@@ -119,6 +128,8 @@ int main(int argc, char** argv) {
     config.imu.accel_bias_walk = FLAGS_bias_walk_accel;
     config.imu.gyro_bias_walk = FLAGS_bias_walk_gyro;
     if (FLAGS_newer_college_extrinsic) config.imu_from_lidar = io::NewerCollegeImuFromLidar();
+    config.start_ns = std::llround(FLAGS_start_s * 1e9);
+    if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
     std::mt19937_64 rng(FLAGS_seed + 17);
     std::uniform_real_distribution<double> u(-40.0, 40.0);
     for (int i = 0; i < FLAGS_pillars; ++i) {
@@ -185,6 +196,16 @@ int main(int argc, char** argv) {
       n = io::WriteSimFolder(source, FLAGS_output, yaml.str(), progress, FLAGS_ground_truth);
     } else if (FLAGS_layout == "newer_college") {
       n = io::WriteNewerCollege(source, FLAGS_output, progress, FLAGS_ground_truth);
+    } else if (FLAGS_layout == "rosbag") {
+      io::RosbagWriteOptions o;
+      o.write_ground_truth = FLAGS_ground_truth;
+      o.compression = FLAGS_bag_compression;
+      n = io::WriteRosbag(source, FLAGS_output, o, progress);
+      if (FLAGS_ground_truth) {
+        std::string stem = FLAGS_output;
+        if (stem.size() > 4 && stem.substr(stem.size() - 4) == ".bag") stem.resize(stem.size() - 4);
+        io::WriteTum(stem + "_ground_truth.tum", *source.GroundTruth());
+      }
     } else {
       throw std::runtime_error("unknown --layout '" + FLAGS_layout + "'");
     }

@@ -8,6 +8,7 @@ packages=(
   libceres-dev libeigen3-dev libsuitesparse-dev libpcl-dev
   libgflags-dev libgoogle-glog-dev libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev python3-matplotlib python3-numpy
+  librosbag-dev libsensor-msgs-dev libtf2-msgs-dev libnav-msgs-dev
 )
 
 missing=()

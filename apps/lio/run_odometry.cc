@@ -1,5 +1,6 @@
 #include "run_odometry.h"
 
+#include <glog/logging.h>
 #include <sys/resource.h>
 
 #include <Eigen/Geometry>
@@ -30,26 +31,40 @@ double Percentile(std::vector<double> v, double p) {
   return v[lo] + (idx - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+namespace {
+
+// The truth at time t: the position (a pose within 1 ms, else interpolated linearly between poses
+// less than 0.2 s apart) and the rotation of the nearest pose. False if t is not covered.
+bool TruthAt(const std::vector<io::StampedPose>& truth, int64_t t, Vec3* p, Mat3* C) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                                   [](const io::StampedPose& q, int64_t x) { return q.t_ns < x; });
+  if (it != truth.end() && std::llabs(it->t_ns - t) <= 1000000) {
+    *p = it->pose.translation();
+    *C = it->pose.rotation();
+  } else if (it != truth.begin() && it != truth.end() && it->t_ns - (it - 1)->t_ns < 200000000) {
+    const double s = double(t - (it - 1)->t_ns) / double(it->t_ns - (it - 1)->t_ns);
+    *p = (1 - s) * (it - 1)->pose.translation() + s * it->pose.translation();
+    *C = (s < 0.5 ? (it - 1) : it)->pose.rotation();
+  } else if (it != truth.begin() && std::llabs((it - 1)->t_ns - t) <= 1000000) {
+    *p = (it - 1)->pose.translation();
+    *C = (it - 1)->pose.rotation();
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth) {
   AteResult r;
   if (truth.size() < 2) return r;
   std::vector<Vec3> est, ref;
   for (const io::StampedPose& e : estimate) {
-    const auto it =
-        std::lower_bound(truth.begin(), truth.end(), e.t_ns,
-                         [](const io::StampedPose& p, int64_t t) { return p.t_ns < t; });
     Vec3 p;
-    if (it != truth.end() && std::llabs(it->t_ns - e.t_ns) <= 1000000) {
-      p = it->pose.translation();
-    } else if (it != truth.begin() && it != truth.end() && it->t_ns - (it - 1)->t_ns < 200000000) {
-      const double s = double(e.t_ns - (it - 1)->t_ns) / double(it->t_ns - (it - 1)->t_ns);
-      p = (1 - s) * (it - 1)->pose.translation() + s * it->pose.translation();
-    } else if (it != truth.begin() && std::llabs((it - 1)->t_ns - e.t_ns) <= 1000000) {
-      p = (it - 1)->pose.translation();
-    } else {
-      continue;
-    }
+    Mat3 C;
+    if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
     est.push_back(e.pose.translation());
     ref.push_back(p);
   }
@@ -78,11 +93,21 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options, double failure_ate) {
-  // The source knows its sensor setup; it overrides the config's.
-  config.T_imu_lidar = source.ImuFromLidar();
+  RunSummary run;
+  if (options.extrinsic_from_config) {
+    run.extrinsic_origin = "the config (extrinsic:)";
+  } else {
+    config.T_imu_lidar = source.ImuFromLidar();
+    run.extrinsic_origin = source.ExtrinsicOrigin();
+  }
+  {
+    const Eigen::AngleAxisd r(config.T_imu_lidar.rotation());
+    LOG(INFO) << "T_imu_lidar from " << run.extrinsic_origin << ": translation ["
+              << config.T_imu_lidar.translation().transpose() << "] m, rotation "
+              << r.angle() * 180.0 / M_PI << " deg about [" << r.axis().transpose() << "]";
+  }
   if (const auto g = source.Gravity()) config.gravity = *g;
   auto odometry = lio::MakeLioOdometry(config);
-  RunSummary run;
   run.method = lio::LioMethodName(config.method);
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
@@ -122,6 +147,11 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     if (r.status != lio::ScanStatus::kFailed) {
       run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
+      if (options.trajectory_rate_hz > 0.0) {
+        auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
+        if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
+        for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_imu_lidar});
+      }
     }
     run.scans.push_back(r);
     if (options.progress) options.progress(done, total, r);
@@ -179,25 +209,60 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
       hi = hi.cwiseMax(p.head<2>());
     }
   }
-  const double span = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3});
-  const double size = 600, margin = 40, scale = (size - 2 * margin) / span;
+  // Square frame around the data with a "nice" tick step (1, 2 or 5 × 10^k m).
+  const double span = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3}) * 1.1;
+  const Eigen::Vector2d centre = 0.5 * (lo + hi);
+  lo = centre - Eigen::Vector2d::Constant(span / 2);
+  const double raw_step = span / 5, mag = std::pow(10.0, std::floor(std::log10(raw_step)));
+  const double step = raw_step / mag < 2 ? 2 * mag : raw_step / mag < 5 ? 5 * mag : 10 * mag;
+  // Title wrapped into lines of at most 80 characters so that it is never cut off.
+  std::vector<std::string> lines(1);
+  std::istringstream words(title);
+  for (std::string w; words >> w;) {
+    if (!lines.back().empty() && lines.back().size() + 1 + w.size() > 80) lines.emplace_back();
+    while (w.size() > 80) {  // a word longer than a line (a long path) is cut
+      lines.back() += w.substr(0, 80);
+      lines.emplace_back();
+      w.erase(0, 80);
+    }
+    lines.back() += (lines.back().empty() ? "" : " ") + w;
+  }
+  const double left = 70, top = 30 + 18.0 * double(lines.size()), size = 520;
+  const double scale = size / span;
+  auto X = [&](double x) { return left + (x - lo.x()) * scale; };
+  auto Y = [&](double y) { return top + size - (y - lo.y()) * scale; };
   auto polyline = [&](const std::vector<Vec3>& v, const char* colour, double width) {
     std::ostringstream s;
     s << "<polyline fill='none' stroke='" << colour << "' stroke-width='" << width << "' points='";
-    for (const Vec3& p : v) {
-      s << margin + (p.x() - lo.x()) * scale << ',' << size - margin - (p.y() - lo.y()) * scale
-        << ' ';
-    }
+    for (const Vec3& p : v) s << X(p.x()) << ',' << Y(p.y()) << ' ';
     s << "'/>\n";
     return s.str();
   };
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write the plot");
-  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << size << "' height='" << size + 30
-    << "'>\n<rect width='100%' height='100%' fill='white'/>\n"
-    << "<text x='10' y='20' font-family='sans-serif' font-size='14'>" << title
-    << " (top view; grey: ground truth, red: estimate; frame " << span << " m)</text>\n"
-    << polyline(ref, "#888888", 3) << polyline(est, "#d62728", 1.5) << "</svg>\n";
+  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << left + size + 30 << "' height='"
+    << top + size + 60 << "' font-family='sans-serif'>\n<rect width='100%' height='100%' "
+    << "fill='white'/>\n";
+  for (size_t i = 0; i < lines.size(); ++i) {
+    f << "<text x='10' y='" << 22 + 18 * i << "' font-size='14'>" << lines[i] << "</text>\n";
+  }
+  f << "<rect x='" << left << "' y='" << top << "' width='" << size << "' height='" << size
+    << "' fill='none' stroke='black'/>\n";
+  for (double v = std::ceil(lo.x() / step) * step; v <= lo.x() + span; v += step) {
+    f << "<text x='" << X(v) << "' y='" << top + size + 16 << "' font-size='11' "
+      << "text-anchor='middle'>" << (std::abs(v) < 1e-9 * step ? 0.0 : v) << "</text>\n";
+  }
+  for (double v = std::ceil(lo.y() / step) * step; v <= lo.y() + span; v += step) {
+    f << "<text x='" << left - 5 << "' y='" << Y(v) + 4 << "' font-size='11' "
+      << "text-anchor='end'>" << (std::abs(v) < 1e-9 * step ? 0.0 : v) << "</text>\n";
+  }
+  f << "<text x='" << left + size / 2 << "' y='" << top + size + 34
+    << "' font-size='12' text-anchor='middle'>x [m]</text>\n<text x='15' y='" << top + size / 2
+    << "' font-size='12'>y [m]</text>\n"
+    << polyline(ref, "#888888", 3) << polyline(est, "#d62728", 1.5) << "<text x='" << left + 10
+    << "' y='" << top + 18 << "' font-size='12' fill='#888888'>ground truth</text>\n<text x='"
+    << left + 10 << "' y='" << top + 34
+    << "' font-size='12' fill='#d62728'>estimate (scan poses, aligned)</text>\n</svg>\n";
 }
 
 void WriteScanLog(const std::string& path, const RunSummary& run) {
@@ -214,6 +279,40 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
       << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << r.ms_marginalize << ' '
       << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
       << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+  }
+}
+
+}  // namespace ctlio::lioapp
+
+namespace ctlio::lioapp {
+
+void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot write the pose errors");
+  f << "t_s,est_x,est_y,est_z,ref_x,ref_y,ref_z,position_error_m,rotation_error_deg\n";
+  f << std::setprecision(12);
+  const Mat3 A = alignment.topLeftCorner<3, 3>();
+  const Vec3 a = alignment.topRightCorner<3, 1>();
+  bool first = true;
+  Mat3 C_e0, C_t0;
+  for (const io::StampedPose& e : estimate) {
+    Vec3 p;
+    Mat3 C;
+    if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
+    if (first) {
+      C_e0 = e.pose.rotation();
+      C_t0 = C;
+      first = false;
+    }
+    const Vec3 q = A * e.pose.translation() + a;
+    // Rotation drift since the first pose: independent of the position-only alignment, which
+    // leaves the rotation free on a short, nearly straight path.
+    const Mat3 dC_truth = C_t0.transpose() * C, dC_est = C_e0.transpose() * e.pose.rotation();
+    const double angle = Eigen::AngleAxisd(dC_truth.transpose() * dC_est).angle();
+    f << 1e-9 * double(e.t_ns) << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << p.x()
+      << ',' << p.y() << ',' << p.z() << ',' << (q - p).norm() << ',' << angle * 180.0 / M_PI
+      << '\n';
   }
 }
 

@@ -17,6 +17,12 @@ namespace ctlio::lioapp {
 
 struct RunOptions {
   size_t max_scans = 0;  // 0 = all
+  // Extrinsic T_imu_lidar precedence: the config's value when it was given explicitly (true),
+  // otherwise the source's (a bag's /tf_static, then a dataset preset or the dataset's files; see
+  // DataSource::ExtrinsicOrigin). The choice is logged and kept in RunSummary::extrinsic_origin.
+  bool extrinsic_from_config = false;
+  // > 0: also sample the estimate at this rate between the scan poses (RunSummary::dense).
+  double trajectory_rate_hz = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
 };
@@ -32,9 +38,13 @@ struct AteResult {
 struct RunSummary {
   std::string method;
   std::string source;
+  std::string extrinsic_origin;  // where T_imu_lidar came from
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
   // estimated (failed scans are left out, never written as garbage).
   std::vector<io::StampedPose> trajectory;
+  // With RunOptions::trajectory_rate_hz: T_world_lidar at that rate (LioOdometry::
+  // SampleNewestInterval after every estimated scan), ending at each scan pose.
+  std::vector<io::StampedPose> dense;
   std::vector<lio::ScanResult> scans;
   int failed = 0, degenerate = 0, imu_gaps = 0;
   std::string first_failure;                           // message of the first failed scan
@@ -58,12 +68,19 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
 AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth);
 
+// Per-pose errors against the truth after `alignment` (estimate → truth frame), CSV:
+// t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg]: the angle of
+// the rotation drift since the first pose, (C_t0ᵀ C_t)ᵀ (C_e0ᵀ C_e), with the truth rotation of the
+// nearest truth pose. Poses outside the truth are left out. Read by tools/plot_odometry.py.
+void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
+                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
+
 // Per-scan log: t, status, keypoints, associations, imu residuals, rounds, solver iterations,
 // final cost, ms, position, message.
 void WriteScanLog(const std::string& path, const RunSummary& run);
 
-// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file: no
-// plotting dependency needed.
+// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file with
+// axes in metres and the title wrapped: the fallback when matplotlib is missing.
 void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment,
                      const std::string& title);

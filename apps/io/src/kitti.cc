@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "ctlio/io/point_fields.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 
@@ -114,11 +115,13 @@ bool KittiReader::Next(ScanFrame* frame) {
       LOG(INFO) << folder_ << ": no per-point times, filled from the azimuth (see kitti.h)";
       logged = true;
     }
+    // KITTI stamps a sweep when the scanner faces forward (azimuth 0): the sweep begins half a
+    // revolution earlier, facing backwards.
     auto& c = frame->cloud;
+    constexpr int64_t kPeriodNs = 100'000'000;
     c.times_ns.resize(c.size());
     for (size_t i = 0; i < c.size(); ++i) {
-      const double az = std::atan2(c.points[i].y(), c.points[i].x());
-      c.times_ns[i] = stamp - std::llround(az / (2.0 * M_PI) * 1e8);
+      c.times_ns[i] = stamp - kPeriodNs / 2 + AzimuthOffsetNs(c.points[i], M_PI, kPeriodNs);
     }
     c.stamp_ns = *std::min_element(c.times_ns.begin(), c.times_ns.end());
   }

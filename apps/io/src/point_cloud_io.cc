@@ -12,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/point_fields.h"
+
 namespace ctlio::io {
 namespace {
 
@@ -169,23 +171,20 @@ double ReadScalar(const uint8_t* p, uint8_t type) {
   }
 }
 
-bool IsInteger(uint8_t type) {
-  return type != pcl::PCLPointField::FLOAT32 && type != pcl::PCLPointField::FLOAT64;
-}
-
 PointCloud FromCloud2(const pcl::PCLPointCloud2& c, const std::string& path,
                       const ReadOptions& options, const std::string& fields_where) {
   const auto* fx = FindField(c, "x");
   const auto* fy = FindField(c, "y");
   const auto* fz = FindField(c, "z");
   if (!fx || !fy || !fz) Fail(path, fields_where + "no x, y and z fields");
-  const auto* ft = FindField(c, "t");
-  const auto* ftime = FindField(c, "time");
-  const auto* fstamp = FindField(c, "timestamp");
-  if (ft && !IsInteger(ft->datatype))
-    Fail(path, fields_where + "field 't' must be an integer (ns)");
-  if (options.require_time && !ft && !ftime && !fstamp) {
-    Fail(path, fields_where + "no per-point time field (expected 't', 'time' or 'timestamp')");
+  // The per-point time convention: one detection for PCD and PointCloud2 (point_fields.h).
+  std::vector<PointField> fields;
+  for (const auto& f : c.fields) fields.push_back({f.name, f.datatype, f.offset, f.count});
+  const PointLayout layout = DetectPointLayout(
+      fields, 0, options.time ? *options.time : TimeFieldOptions{}, path + ": " + fields_where);
+  if (options.require_time && !layout.time) {
+    Fail(path, fields_where + "no per-point time field (expected 't', 'offset_time', 'time' or " +
+                   "'timestamp'; fields found: " + DescribeFields(fields) + ")");
   }
   const auto* fi = FindField(c, "intensity");
   const auto* fr = FindField(c, "ring");
@@ -195,8 +194,7 @@ PointCloud FromCloud2(const pcl::PCLPointCloud2& c, const std::string& path,
   PointCloud out;
   out.stamp_ns = options.stamp_ns;
   out.points.reserve(n);
-  const bool has_time = ft || ftime || fstamp;
-  if (has_time) out.times_ns.reserve(n);
+  if (layout.time) out.times_ns.reserve(n);
   for (size_t i = 0; i < n; ++i) {
     const uint8_t* p = c.data.data() + i * c.point_step;
     const Vec3 x(ReadScalar(p + fx->offset, fx->datatype), ReadScalar(p + fy->offset, fy->datatype),
@@ -206,16 +204,11 @@ PointCloud FromCloud2(const pcl::PCLPointCloud2& c, const std::string& path,
       continue;
     }
     out.points.push_back(x);
-    if (ft) {
-      out.times_ns.push_back(options.stamp_ns + int64_t(ReadScalar(p + ft->offset, ft->datatype)));
-    } else if (ftime) {
-      const double s = ReadScalar(p + ftime->offset, ftime->datatype);
-      if (!std::isfinite(s)) Fail(path, "point " + std::to_string(i) + ": non-finite time");
-      out.times_ns.push_back(options.stamp_ns + std::llround(s * 1e9));
-    } else if (fstamp) {
-      const double s = ReadScalar(p + fstamp->offset, fstamp->datatype);
-      if (!std::isfinite(s)) Fail(path, "point " + std::to_string(i) + ": non-finite timestamp");
-      out.times_ns.push_back(std::llround(s * 1e9));
+    if (layout.time) {
+      int64_t t = 0;
+      if (!PointTimeNs(layout, p, options.stamp_ns, &t))
+        Fail(path, "point " + std::to_string(i) + ": non-finite time");
+      out.times_ns.push_back(t);
     }
     if (fi) out.intensity.push_back(float(ReadScalar(p + fi->offset, fi->datatype)));
     if (fr) out.ring.push_back(uint16_t(ReadScalar(p + fr->offset, fr->datatype)));

@@ -46,6 +46,14 @@ SE3 GpKnotEstimator::PoseAt(const Knot& a, const Knot& b, double tau) const {
 
 SE3 GpKnotEstimator::NewestPose() const { return PoseManifold::Pose(knots_.back().pose).Inverse(); }
 
+std::vector<SE3> GpKnotEstimator::PosesSincePrevious(const std::vector<double>& t) const {
+  const Knot& prev = knots_[knots_.size() - 2];
+  std::vector<SE3> poses;
+  poses.reserve(t.size());
+  for (const double tau : t) poses.push_back(PoseAt(prev, knots_.back(), tau));
+  return poses;
+}
+
 SE3 GpKnotEstimator::PreviousPose() const {
   return PoseManifold::Pose(knots_[knots_.size() - 2].pose).Inverse();
 }

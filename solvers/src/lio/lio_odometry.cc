@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <sstream>
 #include <stdexcept>
@@ -65,6 +66,24 @@ LioOdometry::LioOdometry(const OdometryConfig& config)
       estimator_(MakeEstimator(config_, imu_)) {}
 
 LioOdometry::~LioOdometry() = default;
+
+std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double rate_hz) const {
+  std::vector<std::pair<int64_t, SE3>> out;
+  if (!initialised_ || rate_hz <= 0.0 || estimator_->num_states() < 2) return out;
+  const int64_t origin = imu_.origin_ns();
+  const int64_t begin = origin + std::llround(estimator_->previous_time() * 1e9);
+  const int64_t end = origin + std::llround(estimator_->newest_time() * 1e9);
+  const int64_t period = std::max<int64_t>(1, std::llround(1e9 / rate_hz));
+  std::vector<int64_t> ns;
+  for (int64_t t = (begin / period + 1) * period; t < end; t += period) ns.push_back(t);
+  ns.push_back(end);
+  std::vector<double> t;
+  t.reserve(ns.size());
+  for (const int64_t x : ns) t.push_back(imu_.Seconds(x));
+  const std::vector<SE3> poses = estimator_->PosesSincePrevious(t);
+  for (size_t i = 0; i < ns.size(); ++i) out.emplace_back(ns[i], poses[i]);
+  return out;
+}
 
 ScanResult LioOdometry::AddScan(const LidarScan& scan) {
   const auto start = std::chrono::steady_clock::now();

@@ -108,6 +108,16 @@ NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, d
 
 SE3 NavStateEstimator::NewestPose() const { return PoseManifold::Pose(states_.back().pose); }
 
+std::vector<SE3> NavStateEstimator::PosesSincePrevious(const std::vector<double>& t) const {
+  const State& s = states_.back();
+  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t);
+  const SE3 T_wb_end = PoseManifold::Pose(s.pose) * table.T_end_inv;
+  std::vector<SE3> poses;
+  poses.reserve(t.size());
+  for (const double tau : t) poses.push_back(T_wb_end * table.Interpolate(tau));
+  return poses;
+}
+
 SE3 NavStateEstimator::PreviousPose() const {
   return PoseManifold::Pose(states_[states_.size() - 2].pose);
 }

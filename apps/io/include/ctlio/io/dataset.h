@@ -51,6 +51,8 @@ class DataSource {
   virtual bool Next(ScanFrame* frame) = 0;
   // T_imu_lidar: maps lidar coordinates into the IMU frame.
   virtual SE3 ImuFromLidar() const = 0;
+  // Where ImuFromLidar comes from, for the log ("dataset files", "bag /tf_static", "preset ...").
+  virtual std::string ExtrinsicOrigin() const { return "the dataset (" + Name() + ")"; }
   // Ground truth T_world_lidar, time-sorted, if the source has it.
   virtual std::optional<std::vector<StampedPose>> GroundTruth() const { return std::nullopt; }
   // Gravity magnitude the IMU data assume, if the source knows it (simulator: exact value).

@@ -30,13 +30,14 @@ struct PointCloud {
   double RelativeTime(size_t i) const { return 1e-9 * double(times_ns[i] - stamp_ns); }
 };
 
-// Which per-point time field the readers accept, in order of preference:
-//   "t"         uint32 (or any integer type): nanoseconds since the scan stamp (Ouster driver);
-//   "time"      float/double: seconds since the scan stamp (Velodyne/Hesai drivers);
-//   "timestamp" double: ABSOLUTE seconds (Livox/Hesai); converted to ns.
+// The per-point time field is detected from the field names and types by the drivers'
+// conventions of point_fields.h (Ouster `t`, Livox `offset_time`, Velodyne `time`, Hesai/Robosense
+// and Livox `timestamp`), the same detection as for ROS PointCloud2 messages; `time` overrides it.
+struct TimeFieldOptions;
 struct ReadOptions {
   int64_t stamp_ns = 0;  // the scan stamp (PCD/PLY carry none; Newer College has it in the name)
-  bool require_time = false;  // throw if the file has no per-point time field
+  bool require_time = false;               // throw if the file has no per-point time field
+  const TimeFieldOptions* time = nullptr;  // override of the detected time convention (optional)
 };
 
 // PCD (ascii, binary, binary_compressed) through PCL.

@@ -55,6 +55,12 @@ class Estimator {
   virtual double newest_time() const = 0;
   virtual SE3 NewestPose() const = 0;
   virtual SE3 PreviousPose() const = 0;
+  // Odometry time of the previous state, and the estimate T_mr at times `t` within [previous,
+  // newest] for a dense trajectory between the scan poses: GP interpolation between the two newest
+  // knots (SPEC §2) for the GP pipelines; for the baseline the IMU propagated from the previous
+  // state and anchored at the newest, as its deskewing does.
+  virtual double previous_time() const = 0;
+  virtual std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const = 0;
 
   // How an IMU gap is bridged (for the scan's status message).
   virtual std::string ImuGapRecovery() const = 0;

@@ -34,6 +34,8 @@ class GpKnotEstimator final : public Estimator {
   double newest_time() const override { return knots_.back().t; }
   SE3 NewestPose() const override;
   SE3 PreviousPose() const override;
+  double previous_time() const override { return knots_[knots_.size() - 2].t; }
+  std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
 
  private:

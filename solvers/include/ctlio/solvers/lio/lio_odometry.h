@@ -15,6 +15,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ctlio/solvers/lio/estimator.h"
@@ -53,6 +54,10 @@ class LioOdometry {
   // What the most recent Schur-complement marginalisation did (empty before the first one).
   const MarginalizationReport& last_marginalization() const { return last_marginalization_; }
   int num_marginalizations() const { return num_marginalizations_; }
+  // The estimate T_mr sampled every 1/rate_hz s over the newest interval between states: the
+  // grid times (multiples of the period in absolute ns) in (previous, newest state) and the newest
+  // state's time, whose pose is the scan's T_mr. Empty before the second state.
+  std::vector<std::pair<int64_t, SE3>> SampleNewestInterval(double rate_hz) const;
 
  private:
   void CheckScan(const LidarScan& scan) const;

@@ -32,6 +32,8 @@ class NavStateEstimator final : public Estimator {
   double newest_time() const override { return states_.back().t; }
   SE3 NewestPose() const override;
   SE3 PreviousPose() const override;
+  double previous_time() const override { return states_[states_.size() - 2].t; }
+  std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "bridged by holding the last sample"; }
 
   // A state's blocks live in the window.

@@ -1,0 +1,103 @@
+// ROS 1 bags (sensor_msgs/PointCloud2 + sensor_msgs/Imu) as a DataSource, read with ROS's own bag
+// library (rosbag::Bag, rosbag::View), streamed message by message: only the bag's index and the
+// scans waiting for their IMU samples are in memory, so a bag of tens of GB is fine.
+//
+// Topics: --lidar_topic / --imu_topic; left empty, the only PointCloud2 and the only Imu topic of
+// the bag are used (several candidates: an error listing them). A dataset preset (Newer College
+// 2020/2021, chosen by name or recognised from its topic names) supplies topic names and the
+// extrinsic. Per-point times: point_fields.h (detected from the fields, overridable); a cloud
+// without a time field gets azimuth times (logged once).
+//
+// Extrinsic T_imu_lidar, in this order (ImuFromLidar, ExtrinsicOrigin):
+//   1. (the caller's explicit config value, applied by the odometry runner, not here)
+//   2. /tf_static of the bag, when it connects the IMU's and the lidar's header.frame_id;
+//   3. the preset's published value;
+//   4. identity when the IMU and the lidar messages carry the same frame_id;
+// otherwise ImuFromLidar throws, asking for an `extrinsic:` in the config or a preset.
+//
+// Bad input (std::runtime_error naming the bag and, where it applies, the topic and message
+// number): not a bag, a truncated or corrupted bag (the library's error is passed on), a missing
+// or ambiguous topic, a topic of the wrong type, a cloud that does not decode (point_fields.h),
+// IMU time going backwards, IMU gaps longer than `max_imu_gap_ns`, scans out of order. Duplicate
+// IMU times are dropped with a warning.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ctlio/io/dataset.h"
+#include "ctlio/io/point_fields.h"
+
+namespace ctlio::io {
+
+struct BagPreset {
+  std::string name;         // "newer_college_2020"
+  std::string lidar_topic;  // recognised when this topic exists
+  std::string imu_topic;
+  SE3 imu_from_lidar;
+  std::string note;  // one line for --help and the log
+};
+const std::vector<BagPreset>& BagPresets();
+
+struct RosbagOptions {
+  std::string lidar_topic, imu_topic;  // empty: the only topic of that type, or the preset's
+  std::string preset;                  // empty: recognised from the topics (or none)
+  TimeFieldOptions time;
+  int64_t max_imu_gap_ns = 100'000'000;  // 0 = no check
+  // Multiplies the accelerometer: 9.80665 for IMUs that report g (Livox), whose mean specific
+  // force near 1 is warned about.
+  double accel_scale = 1.0;
+  // Ground truth T_world_lidar read from this topic (nav_msgs/Odometry) when the bag has it.
+  std::string ground_truth_topic = "/ground_truth";
+};
+
+// True if `path` is a regular file starting with the ROS 1 bag magic "#ROSBAG V2.0".
+bool IsRosbagFile(const std::string& path);
+
+class RosbagSource : public DataSource {
+ public:
+  explicit RosbagSource(const std::string& path, const RosbagOptions& options = {});
+  ~RosbagSource() override;
+  std::string Name() const override;
+  size_t NumScans() const override;
+  bool Next(ScanFrame* frame) override;
+  SE3 ImuFromLidar() const override;
+  std::string ExtrinsicOrigin() const override;
+  std::optional<std::vector<StampedPose>> GroundTruth() const override;
+  const std::string& lidar_topic() const;
+  const std::string& imu_topic() const;
+  // Bytes of message data read so far (for throughput reports).
+  uint64_t bytes_read() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct RosbagWriteOptions {
+  std::string lidar_topic = "/os_cloud_node/points";  // ouster_ros names
+  std::string imu_topic = "/os_cloud_node/imu";
+  std::string lidar_frame = "os_lidar", imu_frame = "os_imu";
+  bool write_tf_static = true;       // imu_frame → lidar_frame = source.ImuFromLidar()
+  bool write_ground_truth = true;    // topic /ground_truth (nav_msgs/Odometry) if the source has it
+  std::string compression = "none";  // chunk compression: none | lz4 | bz2 (read transparently)
+};
+
+// Writes any data source as a bag: each scan as an Ouster-style PointCloud2 (OusterFields, `t` =
+// ns since the stamp = scan start), each IMU sample as sensor_msgs/Imu (orientation covariance
+// −1: no orientation), the extrinsic on /tf_static, ground truth on /ground_truth. Returns the
+// number of scans. `progress(done, total)` after each scan.
+size_t WriteRosbag(DataSource& source, const std::string& path,
+                   const RosbagWriteOptions& options = {},
+                   const std::function<void(size_t, size_t)>& progress = {});
+
+// Writes a trajectory as nav_msgs/Odometry messages on `topic` (frame_id `frame`, child
+// `child_frame`), for viewing an estimate in the users' ROS tools.
+void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::string& topic = "/ctlio/odometry",
+                      const std::string& frame = "map",
+                      const std::string& child_frame = "os_lidar");
+
+}  // namespace ctlio::io

@@ -1,0 +1,52 @@
+// The dense trajectory (RunOptions::trajectory_rate_hz, LioOdometry::SampleNewestInterval): at
+// 100 Hz over a short sparse simulated sequence it has a pose every 10 ms, ends every interval at
+// the scan pose, and follows the truth between the scans as closely as the scan poses do.
+#include <gtest/gtest.h>
+
+#include "ctlio/sim/lidar_inertial_sim.h"
+#include "ctlio/solvers/lio/odometry_config.h"
+#include "lio/run_odometry.h"
+
+namespace ctlio::lio {
+namespace {
+
+TEST(DenseTrajectory, EndsAtTheScanPosesAndFollowsTheTruth) {
+  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
+  c.duration_s = 1.0;
+  c.lidar.beams = 16;
+  c.lidar.firing_decimation = 8;
+  for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+    OdometryConfig config =
+        LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+    config.method = m;
+    sim::SimulatedSource source(c);
+    lioapp::RunOptions options;
+    options.trajectory_rate_hz = 100.0;
+    const lioapp::RunSummary run = lioapp::RunOdometry(source, config, options);
+    ASSERT_EQ(run.failed, 0) << run.first_failure;
+    const auto& dense = run.dense;
+    // ~100 poses over 0.9 s of estimated intervals plus the first pose.
+    EXPECT_GE(dense.size(), 80u);
+    for (size_t i = 1; i < dense.size(); ++i) {
+      ASSERT_GT(dense[i].t_ns, dense[i - 1].t_ns);
+      EXPECT_LE(dense[i].t_ns - dense[i - 1].t_ns, 10'000'000);
+    }
+    // Every scan pose is in the dense trajectory, exactly.
+    size_t j = 0;
+    for (const io::StampedPose& p : run.trajectory) {
+      while (j < dense.size() && dense[j].t_ns < p.t_ns) ++j;
+      ASSERT_LT(j, dense.size());
+      ASSERT_EQ(dense[j].t_ns, p.t_ns);
+      EXPECT_LT((dense[j].pose.translation() - p.pose.translation()).norm(), 1e-12);
+    }
+    // Between the scans it tracks the truth about as well as at the scans (a straight line between
+    // scan poses would be off by the motion within 0.1 s).
+    const auto truth = source.GroundTruth();
+    ASSERT_TRUE(truth && run.ate);
+    const lioapp::AteResult dense_ate = lioapp::EvaluateAte(dense, *truth);
+    EXPECT_LT(dense_ate.rmse, 2.0 * run.ate->rmse + 0.005) << LioMethodName(m);
+  }
+}
+
+}  // namespace
+}  // namespace ctlio::lio

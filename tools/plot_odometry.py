@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+"""Plots of a ctlio_odometry run: one figure per method and one comparing the methods.
+
+usage: plot_odometry.py <out_dir> <method_dir> [<method_dir> ...]
+
+Each method folder is what ctlio_odometry writes: trajectory.tum (scan-end poses),
+trajectory_dense.tum (optional, --trajectory_rate), scans.log, evaluation.txt and, with ground
+truth, ground_truth.tum and pose_errors.csv (aligned scan poses and their position/rotation
+errors). Writes <method_dir>/odometry.png and, for several methods, <out_dir>/comparison.png:
+  * top view (x-y) and side view (x-z) in metres: ground truth, the estimate at the densest rate
+    written, the scan poses as dots;
+  * position error [cm] and rotation error [deg] over time;
+  * per-scan run time [ms] over time, coloured by scan status; degenerate, IMU-gap and failed
+    scans marked, gaps in the scan sequence shaded.
+Exit code 3 if matplotlib is missing (the caller then writes its SVG fallback). CTLIO_PLOT_DPI
+sets the resolution (default 90).
+"""
+import csv
+import os
+import sys
+import textwrap
+
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    sys.stderr.write("matplotlib is not installed (Debian: apt install python3-matplotlib)\n")
+    sys.exit(3)
+
+STATUS_COLOURS = {"ok": "#1f77b4", "initialising": "#7f7f7f", "degenerate": "#ff7f0e",
+                  "imu_gap": "#9467bd", "failed": "#d62728"}
+METHOD_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd"]
+
+
+def read_tum(path):
+    rows = []
+    if not os.path.exists(path):
+        return rows
+    with open(path) as f:
+        for line in f:
+            p = line.split()
+            if len(p) >= 8 and not line.startswith("#"):
+                rows.append([float(x) for x in p[:8]])
+    return rows
+
+
+def read_evaluation(path):
+    ev = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                key, _, value = line.strip().partition(" ")
+                ev[key] = value.strip('"')
+    return ev
+
+
+def read_scans(path):
+    scans = []
+    if not os.path.exists(path):
+        return scans
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#"):
+                continue
+            p = line.split()
+            if len(p) >= 9:
+                scans.append((float(p[0]), p[1], float(p[8])))
+    return scans
+
+
+def read_errors(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def alignment_of(ev):
+    """The estimate-to-truth alignment (4x4, row-major in evaluation.txt), applied to positions."""
+    values = [float(x) for x in ev.get("ate_alignment", "").split()]
+    if len(values) != 16:
+        return lambda p: p
+    m = [values[0:4], values[4:8], values[8:12]]
+    return lambda p: [m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3] for i in range(3)]
+
+
+class Run:
+    def __init__(self, folder):
+        self.folder = folder
+        self.ev = read_evaluation(os.path.join(folder, "evaluation.txt"))
+        self.method = self.ev.get("method", os.path.basename(folder.rstrip("/")))
+        self.source = self.ev.get("source", "")
+        align = alignment_of(self.ev)
+        self.scan_poses = [align(r[1:4]) for r in read_tum(os.path.join(folder, "trajectory.tum"))]
+        self.scan_t = [r[0] for r in read_tum(os.path.join(folder, "trajectory.tum"))]
+        dense = read_tum(os.path.join(folder, "trajectory_dense.tum"))
+        self.dense = len(dense) > len(self.scan_poses)
+        self.path = [align(r[1:4]) for r in dense] if self.dense else self.scan_poses
+        self.truth = read_tum(os.path.join(folder, "ground_truth.tum"))
+        if self.truth and self.scan_t:
+            lo, hi = self.scan_t[0] - 0.05, self.scan_t[-1] + 0.05
+            self.truth = [r for r in self.truth if lo <= r[0] <= hi]
+        self.errors = read_errors(os.path.join(folder, "pose_errors.csv"))
+        self.scans = read_scans(os.path.join(folder, "scans.log"))
+        self.t0 = self.scans[0][0] if self.scans else (self.scan_t[0] if self.scan_t else 0.0)
+
+    def ate_text(self):
+        if "ate_rmse_m" in self.ev:
+            return "ATE %.2f cm" % (100.0 * float(self.ev["ate_rmse_m"]))
+        return "no ground truth"
+
+
+def draw_views(ax_top, ax_side, runs, single):
+    truth = runs[0].truth
+    for ax, (i, j), name in ((ax_top, (1, 2), "top view"), (ax_side, (1, 3), "side view")):
+        if truth:
+            ax.plot([r[i] for r in truth], [r[j] for r in truth], color="0.55", lw=3.0,
+                    label="ground truth", zorder=1)
+        for k, run in enumerate(runs):
+            colour = METHOD_COLOURS[k % len(METHOD_COLOURS)]
+            rate = "dense" if run.dense else "scan poses"
+            label = "estimate (%s)" % rate if single else "%s (%s)" % (run.method, rate)
+            ax.plot([p[i - 1] for p in run.path], [p[j - 1] for p in run.path], color=colour,
+                    lw=1.2, label=label, zorder=2)
+            if single:
+                ax.plot([p[i - 1] for p in run.scan_poses], [p[j - 1] for p in run.scan_poses],
+                        ".", color=colour, ms=4, label="scan-end poses", zorder=3)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]" if j == 2 else "z [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(name + (" (aligned to the truth)" if truth else ""))
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+
+
+def draw_errors(ax, runs, single):
+    if not any(run.errors for run in runs):
+        ax.text(0.5, 0.5, "no ground truth: no errors", ha="center", va="center",
+                transform=ax.transAxes)
+        ax.set_axis_off()
+        return
+    ax_rot = ax.twinx() if single else None
+    for k, run in enumerate(runs):
+        colour = METHOD_COLOURS[k % len(METHOD_COLOURS)]
+        t = [e["t_s"] - run.t0 for e in run.errors]
+        ax.plot(t, [100.0 * e["position_error_m"] for e in run.errors], color=colour,
+                label="position" if single else run.method)
+        if ax_rot is not None:
+            ax_rot.plot(t, [e["rotation_error_deg"] for e in run.errors], color="#2ca02c",
+                        ls="--", label="rotation")
+    ax.set_xlabel("time since the first scan [s]")
+    ax.set_ylabel("position error [cm]")
+    ax.set_title("error at the scan poses" + ("" if single else " (position)"))
+    ax.grid(alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    if ax_rot is not None:
+        ax_rot.set_ylabel("rotation drift since the first pose [deg]")
+        h2, l2 = ax_rot.get_legend_handles_labels()
+        handles, labels = handles + h2, labels + l2
+    ax.legend(handles, labels, loc="upper left", fontsize=8)
+
+
+def draw_timing(ax, runs, single):
+    for k, run in enumerate(runs):
+        if not run.scans:
+            continue
+        t = [s[0] - run.t0 for s in run.scans]
+        ms = [s[2] for s in run.scans]
+        if single:
+            for status, colour in STATUS_COLOURS.items():
+                pts = [(a, b) for a, b, s in zip(t, ms, run.scans) if s[1] == status]
+                if pts:
+                    ax.scatter([p[0] for p in pts], [p[1] for p in pts], s=10, color=colour,
+                               label="%s (%d)" % (status, len(pts)), zorder=3)
+            for a, s in zip(t, run.scans):
+                if s[1] in ("degenerate", "imu_gap", "failed"):
+                    ax.axvline(a, color=STATUS_COLOURS[s[1]], alpha=0.4, lw=1)
+        else:
+            ax.plot(t, ms, ".-", ms=3, lw=0.8, color=METHOD_COLOURS[k % len(METHOD_COLOURS)],
+                    label=run.method)
+        # Gaps: a step between scans over 1.5 times the median step.
+        steps = sorted(b - a for a, b in zip(t, t[1:]))
+        if steps:
+            median = steps[len(steps) // 2]
+            first_gap = True
+            for a, b in zip(t, t[1:]):
+                if b - a > 1.5 * median:
+                    ax.axvspan(a, b, color="0.8", alpha=0.5,
+                               label="gap between scans" if first_gap and k == 0 else None)
+                    first_gap = False
+    ax.set_xlabel("time since the first scan [s]")
+    ax.set_ylabel("run time per scan [ms]")
+    ax.set_title("per-scan time and status" if single else "per-scan time")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+
+
+def figure(runs, title, path):
+    single = len(runs) == 1
+    fig, axes = plt.subplots(2, 2, figsize=(12, 9.5), layout="constrained")
+    draw_views(axes[0][0], axes[0][1], runs, single)
+    draw_errors(axes[1][0], runs, single)
+    draw_timing(axes[1][1], runs, single)
+    # Wrapped so that a long source path never runs off the figure.
+    fig.suptitle("\n".join(textwrap.wrap(title, 95)), fontsize=12)
+    fig.savefig(path, dpi=int(os.environ.get("CTLIO_PLOT_DPI", "90")))
+    plt.close(fig)
+    print("wrote " + path)
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.stderr.write(__doc__)
+        return 2
+    out, folders = sys.argv[1], sys.argv[2:]
+    runs = [Run(f) for f in folders]
+    for run in runs:
+        figure([run], "%s on %s: %s, %d scans" % (run.method, run.source, run.ate_text(),
+                                                  len(run.scans)),
+               os.path.join(run.folder, "odometry.png"))
+    if len(runs) > 1:
+        summary = ", ".join("%s %s" % (r.method, r.ate_text()) for r in runs)
+        figure(runs, "%s: %s" % (runs[0].source, summary), os.path.join(out, "comparison.png"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
