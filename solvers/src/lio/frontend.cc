@@ -40,15 +40,6 @@ inline bool PackedKey(const Vec3& p, double inverse_size, uint64_t* key) {
   return true;
 }
 
-inline uint64_t Mix(uint64_t k) {  // splitmix64 finaliser
-  k ^= k >> 30;
-  k *= 0xbf58476d1ce4e5b9ull;
-  k ^= k >> 27;
-  k *= 0x94d049bb133111ebull;
-  k ^= k >> 31;
-  return k;
-}
-
 // Set of packed voxel keys (open addressing, linear probing, load ≤ 1/2) for "first point of its
 // voxel" subsampling. It starts small and doubles as voxels appear: a sweep has a few ten
 // thousand occupied voxels but up to 230 000 points, and sizing the table for the points (4 MB,
@@ -70,7 +61,7 @@ class PackedKeySet {
   // Inserts key; returns whether it was new.
   bool Insert(uint64_t key) {
     if (2 * (size_ + 1) > table_.size()) Grow();
-    for (uint64_t slot = Mix(key) & mask_;; slot = (slot + 1) & mask_) {
+    for (uint64_t slot = MixVoxelHash(key) & mask_;; slot = (slot + 1) & mask_) {
       if (table_[slot] == key) return false;
       if (table_[slot] == kEmpty) {
         table_[slot] = key;
@@ -87,7 +78,7 @@ class PackedKeySet {
     const uint64_t mask = spare_.size() - 1;
     for (const uint64_t key : table_) {
       if (key == kEmpty) continue;
-      uint64_t slot = Mix(key) & mask;
+      uint64_t slot = MixVoxelHash(key) & mask;
       while (spare_[slot] != kEmpty) slot = (slot + 1) & mask;
       spare_[slot] = key;
     }
