@@ -57,9 +57,14 @@ class PackedKeySet {
       std::fill(table_.begin(), table_.end(), kEmpty);
     }
     size_ = 0;
+    last_ = kEmpty;
   }
   // Inserts key; returns whether it was new.
   bool Insert(uint64_t key) {
+    // Consecutive returns of a firing mostly fall in the voxel of the previous one, which is in
+    // the set by then: answer without hashing or probing.
+    if (key == last_) return false;
+    last_ = key;
     if (2 * (size_ + 1) > table_.size()) Grow();
     for (uint64_t slot = MixVoxelHash(key) & mask_;; slot = (slot + 1) & mask_) {
       if (table_[slot] == key) return false;
@@ -88,6 +93,7 @@ class PackedKeySet {
   std::vector<uint64_t> table_, spare_;
   uint64_t mask_ = 0;
   size_t size_ = 0;
+  uint64_t last_ = kEmpty;  // the key of the previous Insert
 };
 
 }  // namespace
