@@ -55,7 +55,9 @@ int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
     slot.voxel = static_cast<int32_t>(keys_.size());
     keys_.push_back(key);
     counts_.push_back(0);
-    pool_.resize(pool_.size() + stride_);
+    if ((keys_.size() - 1) >> kChunkBits >= pool_.size()) {
+      pool_.emplace_back(new Vec3[(size_t{1} << kChunkBits) * stride_]);
+    }
     return slot.voxel;
   }
 }
@@ -80,7 +82,7 @@ bool VoxelMap::Insert(const Vec3& p) {
 bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
   int32_t& count = counts_[voxel];
   if (count >= options_.max_points_per_voxel) return false;
-  Vec3* points = pool_.data() + static_cast<size_t>(voxel) * stride_;
+  Vec3* points = BlockOf(voxel);
   for (int32_t i = 0; i < count; ++i) {
     if ((points[i] - p).squaredNorm() < min_distance2_) return false;
   }
@@ -122,7 +124,8 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
     if (kept != i) {
       keys_[kept] = keys_[i];
       counts_[kept] = counts_[i];
-      std::copy_n(pool_.begin() + i * stride_, counts_[i], pool_.begin() + kept * stride_);
+      std::copy_n(BlockOf(static_cast<int32_t>(i)), counts_[i],
+                  BlockOf(static_cast<int32_t>(kept)));
     }
     ++kept;
   }
@@ -130,7 +133,7 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
   if (removed == 0) return 0;
   keys_.resize(kept);
   counts_.resize(kept);
-  pool_.resize(kept * stride_);
+  pool_.resize((kept + (size_t{1} << kChunkBits) - 1) >> kChunkBits);
   Rehash(2 * kept + 1);
   return removed;
 }

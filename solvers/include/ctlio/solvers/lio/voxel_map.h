@@ -6,14 +6,17 @@
 // it (±1 voxel): every map point within one voxel size of the query is found exactly.
 //
 // Storage is flat: an open-addressing table (linear probing, load ≤ 1/2) maps a voxel key to a
-// voxel index, and the points of voxel i occupy the fixed block [i·max_points_per_voxel, …) of
-// one pool. A lookup is a hash and a few adjacent slots, and a voxel's points are one contiguous
-// block, instead of a node chain and a separate heap block per voxel.
+// voxel index, and the points of voxel i occupy a fixed block of max_points_per_voxel slots in
+// a pool of chunks (256 voxels each: the pool grows without reallocating, so without copies and
+// without a transient second pool in the peak memory). A lookup is a hash and a few adjacent
+// slots, and a voxel's points are one contiguous block, instead of a node chain and a separate
+// heap block per voxel.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "ctlio/manifolds/types.h"
@@ -98,13 +101,17 @@ class VoxelMap {
 
  private:
   static constexpr int32_t kNoVoxel = -1;
+  static constexpr int kChunkBits = 8;  // 256 voxels per pool chunk
   struct Slot {
     VoxelKey key;
     int32_t voxel = kNoVoxel;
   };
+  Vec3* BlockOf(int32_t voxel) const {
+    constexpr int32_t kChunkMask = (1 << kChunkBits) - 1;
+    return pool_[voxel >> kChunkBits].get() + static_cast<size_t>(voxel & kChunkMask) * stride_;
+  }
   VoxelPoints PointsOf(int32_t voxel) const {
-    return {pool_.data() + static_cast<size_t>(voxel) * stride_,
-            static_cast<size_t>(counts_[voxel])};
+    return {BlockOf(voxel), static_cast<size_t>(counts_[voxel])};
   }
   // The voxel index of key, or kNoVoxel.
   int32_t Find(const VoxelKey& key) const;
@@ -118,11 +125,11 @@ class VoxelMap {
   Options options_;
   double inverse_voxel_size_;
   double min_distance2_;
-  size_t stride_;                // max_points_per_voxel
-  std::vector<Slot> slots_;      // power-of-two size, or empty
-  std::vector<VoxelKey> keys_;   // per voxel
-  std::vector<int32_t> counts_;  // per voxel
-  std::vector<Vec3> pool_;       // stride_ points per voxel
+  size_t stride_;                              // max_points_per_voxel
+  std::vector<Slot> slots_;                    // power-of-two size, or empty
+  std::vector<VoxelKey> keys_;                 // per voxel
+  std::vector<int32_t> counts_;                // per voxel
+  std::vector<std::unique_ptr<Vec3[]>> pool_;  // chunks of 2^kChunkBits · stride_ points
   size_t num_points_ = 0;
 };
 
