@@ -19,7 +19,7 @@ std::vector<Vec3> RandomPoints(std::mt19937& rng, int n, double half_extent) {
 
 std::vector<Vec3> AllPoints(const VoxelMap& map) {
   std::vector<Vec3> all;
-  map.ForEachVoxel([&](const VoxelKey&, const std::vector<Vec3>& pts) {
+  map.ForEachVoxel([&](const VoxelKey&, const VoxelPoints& pts) {
     all.insert(all.end(), pts.begin(), pts.end());
   });
   return all;
@@ -37,7 +37,7 @@ TEST(VoxelMap, BoundsAndSpacingHold) {
   EXPECT_LT(kept, pts.size());
   size_t total = 0;
   int full_voxels = 0;
-  map.ForEachVoxel([&](const VoxelKey& key, const std::vector<Vec3>& v) {
+  map.ForEachVoxel([&](const VoxelKey& key, const VoxelPoints& v) {
     total += v.size();
     EXPECT_LE(v.size(), 20u);
     if (v.size() == 20u) ++full_voxels;
@@ -77,7 +77,7 @@ TEST(VoxelMap, RemovesFarVoxelsOnly) {
   const Vec3 location(2.0, -1.0, 0.5);
   // Expected survivors: voxels whose centre is within 5 m.
   size_t expected = 0, expected_points = 0;
-  map.ForEachVoxel([&](const VoxelKey& k, const std::vector<Vec3>& v) {
+  map.ForEachVoxel([&](const VoxelKey& k, const VoxelPoints& v) {
     const Vec3 c = Vec3(k.x + 0.5, k.y + 0.5, k.z + 0.5);
     if ((c - location).norm() <= 5.0) {
       ++expected;
@@ -89,7 +89,7 @@ TEST(VoxelMap, RemovesFarVoxelsOnly) {
   EXPECT_EQ(map.num_voxels(), expected);
   EXPECT_EQ(map.num_points(), expected_points);
   EXPECT_GT(removed, 0u);
-  map.ForEachVoxel([&](const VoxelKey& k, const std::vector<Vec3>&) {
+  map.ForEachVoxel([&](const VoxelKey& k, const VoxelPoints&) {
     EXPECT_LE((Vec3(k.x + 0.5, k.y + 0.5, k.z + 0.5) - location).norm(), 5.0);
   });
   EXPECT_EQ(AllPoints(map).size(), map.num_points());
@@ -145,6 +145,38 @@ TEST(VoxelMap, KNearestSearchesPlusMinusOneVoxel) {
     std::sort(d2.begin(), d2.end());
     const int n = map.KNearest(q, 20, &out);
     ASSERT_EQ(n, std::min<int>(20, static_cast<int>(d2.size())));
+    for (int i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(out[i].squared_distance, d2[i]);
+  }
+}
+
+// RemoveFar compacts the voxels and rebuilds the lookup table: afterwards every surviving point
+// must still be found, removed regions must accept points again, and bounds must still hold.
+TEST(VoxelMap, SearchAndInsertStayExactAfterRemoval) {
+  std::mt19937 rng(15);
+  VoxelMap::Options o;
+  o.max_distance = 4.0;
+  VoxelMap map(o);
+  map.Insert(RandomPoints(rng, 20000, 8.0));  // ~4000 voxels: the table grows several times
+  ASSERT_GT(map.RemoveFar(Vec3(3.0, 3.0, 3.0)), 0u);
+  const size_t voxels_after_removal = map.num_voxels();
+  map.Insert(RandomPoints(rng, 5000, 8.0));  // refills removed voxels, adds to kept ones
+  EXPECT_GT(map.num_voxels(), voxels_after_removal);
+  const std::vector<Vec3> all = AllPoints(map);
+  ASSERT_EQ(all.size(), map.num_points());
+  map.ForEachVoxel([&](const VoxelKey& key, const VoxelPoints& v) {
+    EXPECT_LE(v.size(), 20u);
+    for (const Vec3& p : v) EXPECT_TRUE(VoxelKeyOf(p, 1.0) == key);
+  });
+  std::vector<VoxelMap::Neighbour> out;
+  for (const Vec3& q : RandomPoints(rng, 200, 8.0)) {
+    std::vector<double> d2;
+    for (const Vec3& p : all) {
+      const double d = (p - q).squaredNorm();
+      if (d <= 1.0) d2.push_back(d);
+    }
+    std::sort(d2.begin(), d2.end());
+    const int n = map.KNearest(q, 10, &out, 1.0);
+    ASSERT_EQ(n, std::min<int>(10, static_cast<int>(d2.size())));
     for (int i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(out[i].squared_distance, d2[i]);
   }
 }

@@ -40,15 +40,6 @@ inline bool PackedKey(const Vec3& p, double inverse_size, uint64_t* key) {
   return true;
 }
 
-inline uint64_t Mix(uint64_t k) {  // splitmix64 finaliser
-  k ^= k >> 30;
-  k *= 0xbf58476d1ce4e5b9ull;
-  k ^= k >> 27;
-  k *= 0x94d049bb133111ebull;
-  k ^= k >> 31;
-  return k;
-}
-
 // Set of packed voxel keys (open addressing, linear probing, load ≤ 1/2) for "first point of its
 // voxel" subsampling. It starts small and doubles as voxels appear: a sweep has a few ten
 // thousand occupied voxels but up to 230 000 points, and sizing the table for the points (4 MB,
@@ -66,11 +57,16 @@ class PackedKeySet {
       std::fill(table_.begin(), table_.end(), kEmpty);
     }
     size_ = 0;
+    last_ = kEmpty;
   }
   // Inserts key; returns whether it was new.
   bool Insert(uint64_t key) {
+    // Consecutive returns of a firing mostly fall in the voxel of the previous one, which is in
+    // the set by then: answer without hashing or probing.
+    if (key == last_) return false;
+    last_ = key;
     if (2 * (size_ + 1) > table_.size()) Grow();
-    for (uint64_t slot = Mix(key) & mask_;; slot = (slot + 1) & mask_) {
+    for (uint64_t slot = MixVoxelHash(key) & mask_;; slot = (slot + 1) & mask_) {
       if (table_[slot] == key) return false;
       if (table_[slot] == kEmpty) {
         table_[slot] = key;
@@ -87,7 +83,7 @@ class PackedKeySet {
     const uint64_t mask = spare_.size() - 1;
     for (const uint64_t key : table_) {
       if (key == kEmpty) continue;
-      uint64_t slot = Mix(key) & mask;
+      uint64_t slot = MixVoxelHash(key) & mask;
       while (spare_[slot] != kEmpty) slot = (slot + 1) & mask;
       spare_[slot] = key;
     }
@@ -97,6 +93,7 @@ class PackedKeySet {
   std::vector<uint64_t> table_, spare_;
   uint64_t mask_ = 0;
   size_t size_ = 0;
+  uint64_t last_ = kEmpty;  // the key of the previous Insert
 };
 
 }  // namespace

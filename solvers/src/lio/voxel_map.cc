@@ -2,14 +2,26 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <stdexcept>
 
 namespace ctlio::lio {
 
+namespace {
+
+inline uint64_t HashOf(const VoxelKey& k) {
+  return MixVoxelHash((static_cast<uint64_t>(static_cast<uint32_t>(k.x)) << 42) ^
+                      (static_cast<uint64_t>(static_cast<uint32_t>(k.y)) << 21) ^
+                      static_cast<uint64_t>(static_cast<uint32_t>(k.z)));
+}
+
+}  // namespace
+
 VoxelMap::VoxelMap(const Options& options)
     : options_(options),
       inverse_voxel_size_(1.0 / options.voxel_size),
-      min_distance2_(options.min_point_distance * options.min_point_distance) {
+      min_distance2_(options.min_point_distance * options.min_point_distance),
+      stride_(static_cast<size_t>(std::max(options.max_points_per_voxel, 1))) {
   if (!(options.voxel_size > 0.0) || options.max_points_per_voxel < 1 ||
       !(options.min_point_distance >= 0.0) || !(options.max_distance > 0.0)) {
     throw std::invalid_argument(
@@ -18,34 +30,79 @@ VoxelMap::VoxelMap(const Options& options)
   }
 }
 
-bool VoxelMap::Insert(const Vec3& p) {
-  if (!p.allFinite()) return false;
-  return InsertInto(&voxels_[VoxelKeyOf(p, inverse_voxel_size_)], p);
+int32_t VoxelMap::Find(const VoxelKey& key) const {
+  if (slots_.empty()) return kNoVoxel;
+  const uint64_t mask = slots_.size() - 1;
+  for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
+    const Slot& slot = slots_[s];
+    if (slot.voxel == kNoVoxel || slot.key == key) return slot.voxel;
+  }
 }
 
-bool VoxelMap::InsertInto(Voxel* voxel, const Vec3& p) {
-  if (static_cast<int>(voxel->points.size()) >= options_.max_points_per_voxel) return false;
-  for (const Vec3& existing : voxel->points) {
-    if ((existing - p).squaredNorm() < min_distance2_) return false;
+int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
+  if (2 * (keys_.size() + 1) > slots_.size()) Rehash(2 * (keys_.size() + 1));
+  const uint64_t mask = slots_.size() - 1;
+  for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
+    Slot& slot = slots_[s];
+    if (slot.voxel != kNoVoxel) {
+      if (slot.key == key) return slot.voxel;
+      continue;
+    }
+    if (keys_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+      throw std::length_error("VoxelMap: more than 2^31 voxels");
+    }
+    slot.key = key;
+    slot.voxel = static_cast<int32_t>(keys_.size());
+    keys_.push_back(key);
+    counts_.push_back(0);
+    if ((keys_.size() - 1) >> kChunkBits >= pool_.size()) {
+      pool_.emplace_back(new Vec3[(size_t{1} << kChunkBits) * stride_]);
+    }
+    return slot.voxel;
   }
-  if (voxel->points.empty()) voxel->points.reserve(options_.max_points_per_voxel);
-  voxel->points.push_back(p);
+}
+
+void VoxelMap::Rehash(size_t min_slots) {
+  size_t n = 1024;
+  while (n < min_slots) n *= 2;
+  slots_.assign(n, Slot{});
+  const uint64_t mask = n - 1;
+  for (size_t i = 0; i < keys_.size(); ++i) {
+    uint64_t s = HashOf(keys_[i]) & mask;
+    while (slots_[s].voxel != kNoVoxel) s = (s + 1) & mask;
+    slots_[s] = {keys_[i], static_cast<int32_t>(i)};
+  }
+}
+
+bool VoxelMap::Insert(const Vec3& p) {
+  if (!p.allFinite()) return false;
+  return InsertInto(FindOrAdd(VoxelKeyOf(p, inverse_voxel_size_)), p);
+}
+
+bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
+  int32_t& count = counts_[voxel];
+  if (count >= options_.max_points_per_voxel) return false;
+  Vec3* points = BlockOf(voxel);
+  for (int32_t i = 0; i < count; ++i) {
+    if ((points[i] - p).squaredNorm() < min_distance2_) return false;
+  }
+  points[count++] = p;
   ++num_points_;
   return true;
 }
 
 size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
   // Consecutive points of a sweep (neighbouring beams of one firing) often share a voxel: reuse
-  // the previous hash-map lookup then (element pointers of std::unordered_map stay valid when
-  // it rehashes). Same result as inserting the points one by one.
+  // the previous lookup then (voxel indices stay valid when the table grows). Same result as
+  // inserting the points one by one.
   size_t kept = 0;
-  Voxel* last_voxel = nullptr;
+  int32_t last_voxel = kNoVoxel;
   VoxelKey last_key;
   for (const Vec3& p : points) {
     if (!p.allFinite()) continue;
     const VoxelKey key = VoxelKeyOf(p, inverse_voxel_size_);
-    if (last_voxel == nullptr || !(key == last_key)) {
-      last_voxel = &voxels_[key];
+    if (last_voxel == kNoVoxel || !(key == last_key)) {
+      last_voxel = FindOrAdd(key);
       last_key = key;
     }
     kept += InsertInto(last_voxel, p) ? 1 : 0;
@@ -54,19 +111,30 @@ size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
 }
 
 size_t VoxelMap::RemoveFar(const Vec3& location) {
+  // Compacts the surviving voxels to the front (in order) and rebuilds the table.
   const double max2 = options_.max_distance * options_.max_distance;
-  size_t removed = 0;
-  for (auto it = voxels_.begin(); it != voxels_.end();) {
-    const Vec3 centre =
-        (Vec3(it->first.x, it->first.y, it->first.z) + Vec3::Constant(0.5)) * options_.voxel_size;
+  size_t kept = 0;
+  for (size_t i = 0; i < keys_.size(); ++i) {
+    const VoxelKey& k = keys_[i];
+    const Vec3 centre = (Vec3(k.x, k.y, k.z) + Vec3::Constant(0.5)) * options_.voxel_size;
     if ((centre - location).squaredNorm() > max2) {
-      num_points_ -= it->second.points.size();
-      it = voxels_.erase(it);
-      ++removed;
-    } else {
-      ++it;
+      num_points_ -= static_cast<size_t>(counts_[i]);
+      continue;
     }
+    if (kept != i) {
+      keys_[kept] = keys_[i];
+      counts_[kept] = counts_[i];
+      std::copy_n(BlockOf(static_cast<int32_t>(i)), counts_[i],
+                  BlockOf(static_cast<int32_t>(kept)));
+    }
+    ++kept;
   }
+  const size_t removed = keys_.size() - kept;
+  if (removed == 0) return 0;
+  keys_.resize(kept);
+  counts_.resize(kept);
+  pool_.resize((kept + (size_t{1} << kChunkBits) - 1) >> kChunkBits);
+  Rehash(2 * kept + 1);
   return removed;
 }
 
@@ -94,9 +162,9 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
   for (const auto& [box2, i] : order) {
     if (box2 > max2) break;
     if (static_cast<int>(out->size()) == k && box2 >= out->back().squared_distance) break;
-    const auto it = voxels_.find({c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1});
-    if (it == voxels_.end()) continue;
-    for (const Vec3& p : it->second.points) {
+    const int32_t voxel = Find({c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1});
+    if (voxel == kNoVoxel) continue;
+    for (const Vec3& p : PointsOf(voxel)) {
       const double d2 = (p - q).squaredNorm();
       if (d2 > max2) continue;
       const int n = static_cast<int>(out->size());
@@ -115,7 +183,10 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
 }
 
 void VoxelMap::Clear() {
-  voxels_.clear();
+  slots_.clear();
+  keys_.clear();
+  counts_.clear();
+  pool_.clear();
   num_points_ = 0;
 }
 

@@ -4,12 +4,19 @@
 // density is bounded wherever the robot lingers; voxels farther than `max_distance` (400 m)
 // from the robot are removed. Neighbours of a query are searched in its voxel and the 26 around
 // it (±1 voxel): every map point within one voxel size of the query is found exactly.
+//
+// Storage is flat: an open-addressing table (linear probing, load ≤ 1/2) maps a voxel key to a
+// voxel index, and the points of voxel i occupy a fixed block of max_points_per_voxel slots in
+// a pool of chunks (256 voxels each: the pool grows without reallocating, so without copies and
+// without a transient second pool in the peak memory). A lookup is a hash and a few adjacent
+// slots, and a voxel's points are one contiguous block, instead of a node chain and a separate
+// heap block per voxel.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
+#include <memory>
 #include <vector>
 
 #include "ctlio/manifolds/types.h"
@@ -27,13 +34,26 @@ inline VoxelKey VoxelKeyOf(const Vec3& p, double inverse_voxel_size) {
           static_cast<int32_t>(std::floor(p.z() * inverse_voxel_size))};
 }
 
-struct VoxelKeyHash {
-  // The spatial hash of Teschner et al. (2003), used by CT-ICP and KISS-ICP.
-  size_t operator()(const VoxelKey& k) const {
-    return static_cast<size_t>((static_cast<uint64_t>(static_cast<uint32_t>(k.x)) * 73856093u) ^
-                               (static_cast<uint64_t>(static_cast<uint32_t>(k.y)) * 19349669u) ^
-                               (static_cast<uint64_t>(static_cast<uint32_t>(k.z)) * 83492791u));
-  }
+// splitmix64's finaliser: spreads packed voxel coordinates over the slots of the
+// open-addressing tables (map and subsampling).
+inline uint64_t MixVoxelHash(uint64_t k) {
+  k ^= k >> 30;
+  k *= 0xbf58476d1ce4e5b9ull;
+  k ^= k >> 27;
+  k *= 0x94d049bb133111ebull;
+  k ^= k >> 31;
+  return k;
+}
+
+// The points of one voxel: a contiguous block of the map's pool, valid until the next Insert,
+// RemoveFar or Clear.
+struct VoxelPoints {
+  const Vec3* data = nullptr;
+  size_t count = 0;
+  size_t size() const { return count; }
+  const Vec3* begin() const { return data; }
+  const Vec3* end() const { return data + count; }
+  const Vec3& operator[](size_t i) const { return data[i]; }
 };
 
 class VoxelMap {
@@ -69,27 +89,47 @@ class VoxelMap {
                double max_distance = std::numeric_limits<double>::infinity()) const;
 
   size_t num_points() const { return num_points_; }
-  size_t num_voxels() const { return voxels_.size(); }
+  size_t num_voxels() const { return keys_.size(); }
   const Options& options() const { return options_; }
   void Clear();
 
-  // Calls f(key, points) for every voxel (unordered).
+  // Calls f(key, VoxelPoints) for every voxel (unordered).
   template <typename F>
   void ForEachVoxel(F&& f) const {
-    for (const auto& [key, voxel] : voxels_) f(key, voxel.points);
+    for (size_t i = 0; i < keys_.size(); ++i) f(keys_[i], PointsOf(static_cast<int32_t>(i)));
   }
 
  private:
-  struct Voxel {
-    std::vector<Vec3> points;
+  static constexpr int32_t kNoVoxel = -1;
+  static constexpr int kChunkBits = 8;  // 256 voxels per pool chunk
+  struct Slot {
+    VoxelKey key;
+    int32_t voxel = kNoVoxel;
   };
+  Vec3* BlockOf(int32_t voxel) const {
+    constexpr int32_t kChunkMask = (1 << kChunkBits) - 1;
+    return pool_[voxel >> kChunkBits].get() + static_cast<size_t>(voxel & kChunkMask) * stride_;
+  }
+  VoxelPoints PointsOf(int32_t voxel) const {
+    return {BlockOf(voxel), static_cast<size_t>(counts_[voxel])};
+  }
+  // The voxel index of key, or kNoVoxel.
+  int32_t Find(const VoxelKey& key) const;
+  // The voxel index of key, creating an empty voxel if there is none.
+  int32_t FindOrAdd(const VoxelKey& key);
+  // Rebuilds the slot table for the current voxels with min_slots slots or more (a power of two).
+  void Rehash(size_t min_slots);
   // Insert's body once the voxel of p is known.
-  bool InsertInto(Voxel* voxel, const Vec3& p);
+  bool InsertInto(int32_t voxel, const Vec3& p);
 
   Options options_;
   double inverse_voxel_size_;
   double min_distance2_;
-  std::unordered_map<VoxelKey, Voxel, VoxelKeyHash> voxels_;
+  size_t stride_;                              // max_points_per_voxel
+  std::vector<Slot> slots_;                    // power-of-two size, or empty
+  std::vector<VoxelKey> keys_;                 // per voxel
+  std::vector<int32_t> counts_;                // per voxel
+  std::vector<std::unique_ptr<Vec3[]>> pool_;  // chunks of 2^kChunkBits · stride_ points
   size_t num_points_ = 0;
 };
 
