@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,15 @@ struct PointCloud {
   double RelativeTime(size_t i) const { return 1e-9 * double(times_ns[i] - stamp_ns); }
 };
 
+// Thrown (instead of a plain std::runtime_error) for a well-formed file that cannot be a timed
+// scan: a time field of the wrong type, times that are not times, no time field where one is
+// required. Dataset readers hand such a scan on as an empty one (documented recovery); malformed
+// files stay errors.
+class UnusableCloudError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // Which per-point time field the readers accept, in order of preference:
 //   "t"         uint32 (or any integer type): nanoseconds since the scan stamp (Ouster driver);
 //   "time"      float/double: seconds since the scan stamp (Velodyne/Hesai drivers);
@@ -39,7 +49,8 @@ struct ReadOptions {
   bool require_time = false;  // throw if the file has no per-point time field
 };
 
-// PCD (ascii, binary, binary_compressed) through PCL.
+// PCD (ascii, binary, binary_compressed), read by ctlio itself after the whole file has been
+// checked against its header (sizes, counts, data length, WIDTH×HEIGHT = POINTS < 2^31).
 PointCloud ReadPcd(const std::string& path, const ReadOptions& options = {});
 // PLY (ascii or binary) through PCL; same fields as PCD.
 PointCloud ReadPly(const std::string& path, const ReadOptions& options = {});
