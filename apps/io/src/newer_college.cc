@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/text_table.h"
 
 namespace ctlio::io {
@@ -194,8 +195,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
   const fs::path seq(folder);
   fs::create_directories(ScanDir(seq));
   fs::create_directories(ImuFile(seq).parent_path());
-  std::ofstream imu(ImuFile(seq));
-  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": cannot open for writing");
+  std::ofstream imu = OpenForWriting(ImuFile(seq).string());
   imu << "counter,sec,nsec,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
   size_t counter = 0, n = 0;
   ScanFrame frame;
@@ -214,11 +214,10 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
     ++n;
     if (progress) progress(n, source.NumScans());
   }
-  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": write failed");
+  CloseChecked(imu, ImuFile(seq).string());
   if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
     fs::create_directories(GtFile(seq).parent_path());
-    std::ofstream out(GtFile(seq));
-    if (!out) throw std::runtime_error(GtFile(seq).string() + ": cannot open for writing");
+    std::ofstream out = OpenForWriting(GtFile(seq).string());
     out << "#sec,nsec,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
     for (const auto& p : *gt) {
       const Eigen::Quaterniond q = p.pose.quaternion();
@@ -226,6 +225,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
       out << p.t_ns / 1000000000 << ',' << p.t_ns % 1000000000 << ',' << r.x() << ',' << r.y()
           << ',' << r.z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << '\n';
     }
+    CloseChecked(out, GtFile(seq).string());
   }
   return n;
 }

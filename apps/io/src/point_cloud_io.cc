@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/dataset.h"
 #include "raw_cloud.h"
 
@@ -334,8 +335,7 @@ void WritePly(const std::string& path, const PointCloud& cloud) {
 void WriteKittiBin(const std::string& path, const PointCloud& cloud,
                    const std::string& times_path) {
   CheckCloud(cloud, path);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) Fail(path, "cannot open for writing");
+  std::ofstream out = OpenForWriting(path, std::ios::binary | std::ios::trunc);
   const size_t n = cloud.size();
   for (size_t i = 0; i < n; ++i) {
     const float v[4] = {float(cloud.points[i].x()), float(cloud.points[i].y()),
@@ -343,16 +343,15 @@ void WriteKittiBin(const std::string& path, const PointCloud& cloud,
                         cloud.intensity.size() == n ? cloud.intensity[i] : 0.f};
     out.write(reinterpret_cast<const char*>(v), sizeof(v));
   }
-  if (!out) Fail(path, "write failed");
+  CloseChecked(out, path);
   if (!times_path.empty()) {
-    std::ofstream tout(times_path, std::ios::binary);
-    if (!tout) Fail(times_path, "cannot open for writing");
+    std::ofstream tout = OpenForWriting(times_path, std::ios::binary | std::ios::trunc);
     for (size_t i = 0; i < n; ++i) {
       const float s =
           cloud.has_times() ? float(1e-9 * double(cloud.times_ns[i] - cloud.stamp_ns)) : 0.f;
       tout.write(reinterpret_cast<const char*>(&s), sizeof(s));
     }
-    if (!tout) Fail(times_path, "write failed");
+    CloseChecked(tout, times_path);
   }
 }
 

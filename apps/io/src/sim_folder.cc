@@ -13,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 
@@ -50,8 +51,7 @@ PointCloud ReadSimScan(const std::string& path, int64_t start_ns) {
 }
 
 void WriteSimScan(const std::string& path, const PointCloud& cloud) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  std::ofstream out = OpenForWriting(path, std::ios::binary | std::ios::trunc);
   std::vector<char> buf(16 * cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
     const float v[3] = {float(cloud.points[i].x()), float(cloud.points[i].y()),
@@ -65,7 +65,7 @@ void WriteSimScan(const std::string& path, const PointCloud& cloud) {
     std::memcpy(buf.data() + 16 * i + 12, &u, 4);
   }
   out.write(buf.data(), std::streamsize(buf.size()));
-  if (!out) throw std::runtime_error(path + ": write failed");
+  CloseChecked(out, path);
 }
 
 SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_error_ns)
@@ -196,13 +196,13 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     y << YAML::EndMap;
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
-    std::ofstream out(dir / "ctlio_sim.yaml");
-    out << "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n"
-        << y.c_str() << "\n";
-    if (!out) throw std::runtime_error((dir / "ctlio_sim.yaml").string() + ": write failed");
+    WriteTextFile((dir / "ctlio_sim.yaml").string(),
+                  "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" +
+                      std::string(y.c_str()) + "\n");
   }
-  std::ofstream imu(dir / "imu.csv"), scans(dir / "scans.csv");
-  if (!imu || !scans) throw std::runtime_error(folder + ": cannot write imu.csv/scans.csv");
+  const std::string imu_path = (dir / "imu.csv").string(),
+                    scans_path = (dir / "scans.csv").string();
+  std::ofstream imu = OpenForWriting(imu_path), scans = OpenForWriting(scans_path);
   imu << "t_ns,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
   scans << "index,start_ns,end_ns,points,file\n";
   ScanFrame frame;
@@ -222,9 +222,11 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     ++n;
     if (progress) progress(n, source.NumScans());
   }
-  if (!imu || !scans) throw std::runtime_error(folder + ": write failed");
+  CloseChecked(imu, imu_path);
+  CloseChecked(scans, scans_path);
   if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
-    std::ofstream out(dir / "ground_truth.csv");
+    const std::string gt_path = (dir / "ground_truth.csv").string();
+    std::ofstream out = OpenForWriting(gt_path);
     out << "t_ns,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
     for (const auto& p : *gt) {
       const Eigen::Quaterniond q = p.pose.quaternion();
@@ -232,6 +234,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
       out << p.t_ns << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ',' << q.y()
           << ',' << q.z() << ',' << q.w() << '\n';
     }
+    CloseChecked(out, gt_path);
     WriteTum((dir / "ground_truth_tum.txt").string(), *gt);
   }
   return n;
