@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs ctlio's build and test dependencies from Debian 12 packages.
+# Installs ctlio's build and test dependencies from Debian 12 packages (clang and its runtime
+# libclang-rt-14-dev build the libFuzzer targets of scripts/fuzz.sh).
 # Safe to re-run: when everything is present it only checks and returns.
 set -euo pipefail
 
@@ -8,6 +9,7 @@ packages=(
   libceres-dev libeigen3-dev libsuitesparse-dev libpcl-dev
   libgflags-dev libgoogle-glog-dev libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev python3-matplotlib python3-numpy
+  clang libclang-rt-14-dev
 )
 
 missing=()

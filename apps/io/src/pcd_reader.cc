@@ -71,66 +71,6 @@ ScalarType TypeOf(const std::string& path, int line, char type, size_t size) {
                " is not a PCD scalar (F: 4 or 8; U, I: 1, 2, 4 or 8)");
 }
 
-// Writes the ascii token `tok` as a value of `type` at `out`; false if it does not parse or does
-// not fit (an integer field holding "nan" or 300 in a uint8 is malformed, not converted).
-bool StoreAscii(const std::string& tok, ScalarType type, uint8_t* out) {
-  const char* s = tok.c_str();
-  char* end = nullptr;
-  errno = 0;
-  if (!IsIntegerType(type)) {
-    const double v = std::strtod(s, &end);
-    if (end != s + tok.size()) return false;
-    if (type == ScalarType::kFloat64) {
-      std::memcpy(out, &v, 8);
-    } else {
-      const float f = static_cast<float>(v);  // out of range → ±inf, dropped as non-finite
-      std::memcpy(out, &f, 4);
-    }
-    return true;
-  }
-  auto put = [&](auto v) { std::memcpy(out, &v, sizeof(v)); };
-  if (type == ScalarType::kUint64) {
-    if (tok[0] == '-') return false;
-    const unsigned long long v = std::strtoull(s, &end, 10);
-    if (end != s + tok.size() || errno == ERANGE) return false;
-    put(uint64_t(v));
-    return true;
-  }
-  const long long v = std::strtoll(s, &end, 10);
-  if (end != s + tok.size() || errno == ERANGE) return false;
-  auto fits = [&](auto lo, auto hi) { return v >= (long long)lo && v <= (long long)hi; };
-  switch (type) {
-    case ScalarType::kInt8:
-      if (!fits(INT8_MIN, INT8_MAX)) return false;
-      put(int8_t(v));
-      break;
-    case ScalarType::kUint8:
-      if (!fits(0, UINT8_MAX)) return false;
-      put(uint8_t(v));
-      break;
-    case ScalarType::kInt16:
-      if (!fits(INT16_MIN, INT16_MAX)) return false;
-      put(int16_t(v));
-      break;
-    case ScalarType::kUint16:
-      if (!fits(0, UINT16_MAX)) return false;
-      put(uint16_t(v));
-      break;
-    case ScalarType::kInt32:
-      if (!fits(INT32_MIN, INT32_MAX)) return false;
-      put(int32_t(v));
-      break;
-    case ScalarType::kUint32:
-      if (!fits(0, UINT32_MAX)) return false;
-      put(uint32_t(v));
-      break;
-    default:
-      put(int64_t(v));
-      break;
-  }
-  return true;
-}
-
 // LZF decompression (the format of PCD binary_compressed): a control byte c < 32 copies the next
 // c + 1 literal bytes; otherwise length = c >> 5 (7 = extended by the next byte) + 2 bytes are
 // copied from distance ((c & 31) << 8) + next byte + 1 back in the output. Every read and write is
@@ -301,7 +241,7 @@ void ReadAsciiData(const std::string& path, const std::vector<char>& bytes, size
     size_t k = 0;
     for (const auto& f : c->fields) {
       for (size_t e = 0; e < f.count; ++e, ++k) {
-        if (!StoreAscii(tok[k], f.type, record.data() + f.offset + e * ScalarSize(f.type))) {
+        if (!StoreAsciiValue(tok[k], f.type, record.data() + f.offset + e * ScalarSize(f.type))) {
           FailLine(path, n,
                    "value " + std::to_string(k + 1) + " ('" + tok[k].substr(0, 32) +
                        "') is not a valid " + f.name);

@@ -110,56 +110,6 @@ PointCloud FromRaw(const detail::RawCloud& c, const std::string& path, const Rea
   return out;
 }
 
-// PCL's PLY cloud as a RawCloud (field table checked against the record size).
-detail::RawCloud FromPcl(const pcl::PCLPointCloud2& pc, const std::string& path) {
-  using detail::ScalarType;
-  detail::RawCloud c;
-  c.point_step = pc.point_step;
-  c.points = size_t(pc.width) * pc.height;
-  c.fields_where = "header (element vertex properties): ";
-  for (const auto& f : pc.fields) {
-    detail::FieldDesc d;
-    d.name = f.name;
-    switch (f.datatype) {
-      case pcl::PCLPointField::INT8:
-        d.type = ScalarType::kInt8;
-        break;
-      case pcl::PCLPointField::UINT8:
-        d.type = ScalarType::kUint8;
-        break;
-      case pcl::PCLPointField::INT16:
-        d.type = ScalarType::kInt16;
-        break;
-      case pcl::PCLPointField::UINT16:
-        d.type = ScalarType::kUint16;
-        break;
-      case pcl::PCLPointField::INT32:
-        d.type = ScalarType::kInt32;
-        break;
-      case pcl::PCLPointField::UINT32:
-        d.type = ScalarType::kUint32;
-        break;
-      case pcl::PCLPointField::FLOAT32:
-        d.type = ScalarType::kFloat32;
-        break;
-      case pcl::PCLPointField::FLOAT64:
-        d.type = ScalarType::kFloat64;
-        break;
-      default:
-        continue;  // a type ctlio does not read (e.g. list properties)
-    }
-    d.count = std::max<size_t>(1, f.count);
-    d.offset = f.offset;
-    if (d.offset + detail::ScalarSize(d.type) * d.count > c.point_step) {
-      Fail(path, c.fields_where + "property '" + f.name + "' lies outside the vertex record");
-    }
-    c.fields.push_back(d);
-  }
-  if (pc.data.size() < c.points * c.point_step) Fail(path, "data shorter than its vertices");
-  c.data.assign(pc.data.begin(), pc.data.begin() + c.points * c.point_step);
-  return c;
-}
-
 template <typename T>
 void AddField(pcl::PCLPointCloud2* c, const std::string& name, uint8_t type) {
   pcl::PCLPointField f;
@@ -209,10 +159,7 @@ PointCloud ReadPcd(const std::string& path, const ReadOptions& options) {
 
 PointCloud ReadPly(const std::string& path, const ReadOptions& options) {
   RequireFile(path);
-  pcl::PCLPointCloud2 c;
-  pcl::PLYReader reader;
-  if (reader.read(path, c) < 0) Fail(path, "PCL could not parse the PLY header or data");
-  return FromRaw(FromPcl(c, path), path, options);
+  return FromRaw(detail::ReadPlyRaw(path), path, options);
 }
 
 PointCloud ReadPointCloud(const std::string& path, const ReadOptions& options) {

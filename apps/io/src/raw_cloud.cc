@@ -1,5 +1,8 @@
 #include "raw_cloud.h"
 
+#include <cerrno>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 
@@ -14,6 +17,67 @@ T Load(const uint8_t* p) {
 }
 
 }  // namespace
+
+// (raw_cloud.h) Writes the ascii token `tok` as a value of `type` at `out`; false if it does not
+// parse or does not fit (an integer field holding "nan" or 300 in a uint8 is malformed, not
+// converted).
+bool StoreAsciiValue(const std::string& tok, ScalarType type, uint8_t* out) {
+  const char* s = tok.c_str();
+  char* end = nullptr;
+  errno = 0;
+  if (!IsIntegerType(type)) {
+    const double v = std::strtod(s, &end);
+    if (end != s + tok.size()) return false;
+    if (type == ScalarType::kFloat64) {
+      std::memcpy(out, &v, 8);
+    } else {
+      const float f = static_cast<float>(v);  // out of range → ±inf, dropped as non-finite
+      std::memcpy(out, &f, 4);
+    }
+    return true;
+  }
+  auto put = [&](auto v) { std::memcpy(out, &v, sizeof(v)); };
+  if (type == ScalarType::kUint64) {
+    if (tok[0] == '-') return false;
+    const unsigned long long v = std::strtoull(s, &end, 10);
+    if (end != s + tok.size() || errno == ERANGE) return false;
+    put(uint64_t(v));
+    return true;
+  }
+  const long long v = std::strtoll(s, &end, 10);
+  if (end != s + tok.size() || errno == ERANGE) return false;
+  auto fits = [&](auto lo, auto hi) { return v >= (long long)lo && v <= (long long)hi; };
+  switch (type) {
+    case ScalarType::kInt8:
+      if (!fits(INT8_MIN, INT8_MAX)) return false;
+      put(int8_t(v));
+      break;
+    case ScalarType::kUint8:
+      if (!fits(0, UINT8_MAX)) return false;
+      put(uint8_t(v));
+      break;
+    case ScalarType::kInt16:
+      if (!fits(INT16_MIN, INT16_MAX)) return false;
+      put(int16_t(v));
+      break;
+    case ScalarType::kUint16:
+      if (!fits(0, UINT16_MAX)) return false;
+      put(uint16_t(v));
+      break;
+    case ScalarType::kInt32:
+      if (!fits(INT32_MIN, INT32_MAX)) return false;
+      put(int32_t(v));
+      break;
+    case ScalarType::kUint32:
+      if (!fits(0, UINT32_MAX)) return false;
+      put(uint32_t(v));
+      break;
+    default:
+      put(int64_t(v));
+      break;
+  }
+  return true;
+}
 
 size_t ScalarSize(ScalarType type) {
   switch (type) {

@@ -49,6 +49,17 @@ double ReadAsDouble(const RawCloud& cloud, size_t i, const FieldDesc& f, size_t 
 // Reads an integer field exactly; false for a float field or a uint64 value above INT64_MAX.
 bool ReadAsInt64(const RawCloud& cloud, size_t i, const FieldDesc& f, int64_t* value);
 
+// Writes the ascii token `tok` as a value of `type` at `out`; false if it does not parse or does
+// not fit the type (an integer field holding "nan", or 300 in a uint8, is malformed).
+bool StoreAsciiValue(const std::string& tok, ScalarType type, uint8_t* out);
+
+// Reads a PLY file (format ascii, binary_little_endian or binary_big_endian 1.0) without PCL: the
+// `vertex` element, first in the file, with scalar properties (list properties of later elements
+// are never read). The vertex data must hold exactly the declared count (ascii: one line per
+// vertex with one value per property); when vertex is the only element nothing but whitespace
+// (ascii) or zero bytes (binary) may follow. Throws "<path>: line N: <what>" or "<path>: <what>".
+RawCloud ReadPlyRaw(const std::string& path);
+
 // Reads a PCD file (DATA ascii, binary or binary_compressed) after checking the whole file
 // against its header: known keys only, each once, FIELDS/SIZE/TYPE/COUNT of one length, sizes
 // valid for their types, WIDTH×HEIGHT = POINTS < 2^31, and a data section holding exactly POINTS

@@ -52,7 +52,8 @@ struct ReadOptions {
 // PCD (ascii, binary, binary_compressed), read by ctlio itself after the whole file has been
 // checked against its header (sizes, counts, data length, WIDTH×HEIGHT = POINTS < 2^31).
 PointCloud ReadPcd(const std::string& path, const ReadOptions& options = {});
-// PLY (ascii or binary) through PCL; same fields as PCD.
+// PLY (ascii, binary little or big endian), read by ctlio itself (the vertex element's scalar
+// properties, checked against the header); same fields as PCD.
 PointCloud ReadPly(const std::string& path, const ReadOptions& options = {});
 // Dispatch on the extension (.pcd, .ply, .bin).
 PointCloud ReadPointCloud(const std::string& path, const ReadOptions& options = {});

@@ -1,0 +1,60 @@
+// Shared helpers of the libFuzzer targets (fuzz/README in the project README, "Fuzzing"): every
+// target writes the fuzzer's bytes into files of a per-process scratch folder and runs one reader
+// on them. A reader may throw std::exception (a clear error); anything else — a crash, a
+// sanitizer report, another exception type, a hang — is a finding.
+#pragma once
+
+#include <glog/logging.h>
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace ctlio::fuzz {
+
+// The scratch folder of this process (emptied on first use).
+inline const std::filesystem::path& ScratchDir(const std::string& target) {
+  static const std::filesystem::path dir = [&] {
+    const auto d = std::filesystem::temp_directory_path() /
+                   ("ctlio_fuzz_" + target + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+inline void WriteFile(const std::filesystem::path& p, const std::string& bytes) {
+  std::filesystem::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size());
+}
+
+// Several files in one input: parts separated by the line "%%" (the seed corpus uses the same
+// separator, so the fuzzer mutates each file and the split alike).
+inline std::vector<std::string> SplitParts(const uint8_t* data, size_t size, size_t parts) {
+  const std::string all(reinterpret_cast<const char*>(data), size);
+  const std::string sep = "\n%%\n";
+  std::vector<std::string> out;
+  size_t pos = 0;
+  while (out.size() + 1 < parts) {
+    const size_t at = all.find(sep, pos);
+    if (at == std::string::npos) break;
+    out.push_back(all.substr(pos, at - pos));
+    pos = at + sep.size();
+  }
+  out.push_back(all.substr(pos));
+  out.resize(parts);
+  return out;
+}
+
+// Readers log warnings for every recovery: keep the fuzzer's output to its findings.
+inline void QuietLogging() {
+  FLAGS_minloglevel = 3;
+  FLAGS_logtostderr = true;
+}
+
+}  // namespace ctlio::fuzz
