@@ -8,7 +8,10 @@
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
 // alignment) with DIR/trajectory_topview.svg (estimate over ground truth). Several methods
-// separated by commas run one after the other and print their ATE side by side.
+// separated by commas run one after the other and print their ATE side by side. Every write is
+// checked (a full disk or an unwritable path is an error naming the path, exit 2); the input gates
+// of lio/input_checks.h apply (config section `input:`), and --max_imu_gap_error makes IMU gaps in
+// the dataset files an error instead of a warning (README, "IMU gaps").
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
