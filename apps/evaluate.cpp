@@ -147,7 +147,9 @@ int main(int argc, char** argv) {
           if (std::system(cmd.c_str()) == 0) {
             std::cout << "wrote top_view.png, error_over_time.png\n";
           } else {
-            std::cout << "plots skipped: the plot script failed (" << cmd << ")\n";
+            // The plots were asked for and python is there: a failure (e.g. a full disk) is an
+            // error, not a silently missing PNG.
+            throw std::runtime_error(out.string() + ": the plot script failed (" + cmd + ")");
           }
         }
       }
