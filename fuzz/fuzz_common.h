@@ -16,16 +16,27 @@
 
 namespace ctlio::fuzz {
 
-// The scratch folder of this process (emptied on first use).
+// The scratch folder of this process (emptied on first use, removed at exit).
 inline const std::filesystem::path& ScratchDir(const std::string& target) {
-  static const std::filesystem::path dir = [&] {
-    const auto d = std::filesystem::temp_directory_path() /
-                   ("ctlio_fuzz_" + target + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
+  struct Folder {
+    std::filesystem::path path;
+    ~Folder() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Folder dir = [&] {
+    // In memory where available: a folder target writes up to six files per input.
+    std::error_code ec;
+    const std::filesystem::path base = std::filesystem::is_directory("/dev/shm", ec)
+                                           ? std::filesystem::path("/dev/shm")
+                                           : std::filesystem::temp_directory_path();
+    Folder f{base / ("ctlio_fuzz_" + target + "_" + std::to_string(::getpid()))};
+    std::filesystem::remove_all(f.path);
+    std::filesystem::create_directories(f.path);
+    return f;
   }();
-  return dir;
+  return dir.path;
 }
 
 inline void WriteFile(const std::filesystem::path& p, const std::string& bytes) {
