@@ -31,7 +31,8 @@
 
 DEFINE_string(out, "", "Output folder (required)");
 DEFINE_string(config, "", "YAML config (default: data/sim_lio.yaml of the source tree)");
-DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes");
+DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes (also walking, vehicle)");
+DEFINE_string(world, "box", "Simulated world: box | street | corridor | park | indoor");
 DEFINE_string(methods, "singer_lio,imu_input,lidar_gyro,lidar_only", "Comma-separated methods");
 DEFINE_int32(sequences, 20, "Sequences per regime (the paper: 20)");
 DEFINE_int32(first_sequence, 0, "Index of the first sequence");
@@ -142,6 +143,7 @@ int main(int argc, char** argv) {
     const auto regimes = Split(FLAGS_regimes);
     const auto methods = Split(FLAGS_methods);
     for (const auto& r : regimes) sim::ParseRegime(r);
+    sim::ParseWorld(FLAGS_world);
     for (const auto& m : methods) lio::ParseLioMethod(m);
 
     std::vector<Job> jobs;
@@ -161,7 +163,9 @@ int main(int argc, char** argv) {
       for (size_t j = next++; j < jobs.size(); j = next++) {
         Job& job = jobs[j];
         try {
-          sim::SimConfig c = sim::ExperimentConfig(sim::ParseRegime(job.regime), job.index);
+          sim::SimConfig c =
+              sim::ExperimentConfig(sim::ParseRegime(job.regime), job.index, sim::kExperimentSeed,
+                                    sim::ParseWorld(FLAGS_world));
           c.duration_s = FLAGS_duration;
           c.lidar.beams = FLAGS_beams;
           c.lidar.firing_decimation = FLAGS_firing_decimation;
@@ -210,7 +214,7 @@ int main(int argc, char** argv) {
     // fail (so one diverged run is counted as a failure and does not swamp the mean), and the
     // same over all runs for completeness.
     std::ostringstream md;
-    md << "# Table II (ctlio): RMSE ATE [m] per regime and method\n\n";
+    md << "# Table II (ctlio): RMSE ATE [m] per regime and method, world " << FLAGS_world << "\n\n";
     md << "Settings: " << FLAGS_sequences << " sequences per regime (from index "
        << FLAGS_first_sequence << "), " << FLAGS_duration << " s each, " << FLAGS_beams
        << " beams, firing decimation " << FLAGS_firing_decimation << ", "

@@ -48,7 +48,8 @@ DEFINE_double(max_imu_gap_error, 0.0,
               "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
               "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
-DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast");
+DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
+DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
 DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
@@ -61,12 +62,15 @@ using namespace ctlio;
 std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
   const int64_t gap_ns = std::llround(max_imu_gap_error_s * 1e9);
   if (FLAGS_format == "sim") {
-    sim::SimConfig c = sim::ExperimentConfig(sim::ParseRegime(FLAGS_sim_regime), FLAGS_sim_index);
+    sim::SimConfig c =
+        sim::ExperimentConfig(sim::ParseRegime(FLAGS_sim_regime), FLAGS_sim_index,
+                              sim::kExperimentSeed, sim::ParseWorld(FLAGS_sim_world));
     c.duration_s = FLAGS_sim_duration;
     c.lidar.firing_decimation = FLAGS_sim_firing_decimation;
     c.lidar.beams = FLAGS_sim_beams;
     std::ostringstream name;
-    name << "sim:" << FLAGS_sim_regime << "/" << FLAGS_sim_index;
+    name << "sim:" << (FLAGS_sim_world == "box" ? "" : FLAGS_sim_world + "/") << FLAGS_sim_regime
+         << "/" << FLAGS_sim_index;
     return std::make_unique<sim::SimulatedSource>(c, name.str());
   }
   if (FLAGS_dataset.empty()) throw std::runtime_error("--dataset is required (or --format sim)");

@@ -3,6 +3,10 @@
 //
 //   ctlio_simulate --regime=fast --index=3 --output=/tmp/fast_03 [--layout=newer_college]
 //                  [--firing_decimation=4] [--duration=20] [--body_centric] [--pillars=4]
+//   ctlio_simulate --world=street --regime=vehicle --output=/tmp/street [--topview=street.svg]
+//                  [--imu_dropout=5.0:0.5,12:2] [--lidar_dropout=0.1] [--gyro_limit=4] ...
+//
+// Realism and outage flags default to off (the simulator of SPEC §6).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -19,7 +23,24 @@
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
 DEFINE_string(layout, "ctlio", "Folder layout: ctlio | newer_college");
-DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast");
+DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | vehicle");
+DEFINE_string(world, "box", "World: box | street | corridor | park | indoor");
+DEFINE_uint64(world_seed, ctlio::sim::kExperimentSeed, "Seed of the world's geometry");
+DEFINE_string(topview, "", "Also write a top view of the world and its path (SVG) to this file");
+DEFINE_double(range_noise_per_m, 0.0, "Range noise growing with range: σ = 0.02 m + k·r");
+DEFINE_double(lidar_dropout, 0.0, "Probability that a lidar return is lost at random");
+DEFINE_double(max_incidence_deg, 90.0, "Returns at a larger incidence angle are lost");
+DEFINE_double(reflect_range, 0.0, "Weak echoes: a return needs r ≤ this·√cos(incidence); 0 = off");
+DEFINE_double(beam_elevation_error_deg, 0.0, "σ of fixed per-beam elevation errors [deg]");
+DEFINE_double(beam_azimuth_error_deg, 0.0, "σ of fixed per-beam azimuth errors [deg]");
+DEFINE_string(accel_scale, "0,0,0", "Accelerometer scale-factor errors s (x,y,z): (1+s)·f");
+DEFINE_string(gyro_scale, "0,0,0", "Gyro scale-factor errors s (x,y,z): (1+s)·ω");
+DEFINE_double(accel_limit, 0.0, "Accelerometer saturation per axis [m/s²]; 0 = none");
+DEFINE_double(gyro_limit, 0.0, "Gyro saturation per axis [rad/s]; 0 = none");
+DEFINE_string(imu_dropout, "", "IMU outages start:length in seconds, e.g. 5.0:0.5,12:2");
+DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second (Poisson); 0 = none");
+DEFINE_double(imu_outage_min, 0.1, "Shortest random IMU outage [s]");
+DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
 DEFINE_int32(index, 0, "Sequence index within the regime (the experiment uses 0..19)");
 DEFINE_uint64(seed, ctlio::sim::kExperimentSeed, "Experiment seed (documented default)");
 DEFINE_double(duration, 20.0, "Sequence length [s]");
@@ -34,6 +55,30 @@ DEFINE_bool(newer_college_extrinsic, false,
             "Use the Newer College lidar→IMU extrinsic instead of identity (always used with "
             "--layout=newer_college, which cannot carry another)");
 
+namespace {
+
+// "a,b,c" → Vec3 (one number repeats on all axes).
+ctlio::Vec3 ParseVec3(const std::string& flag, const std::string& text) {
+  std::stringstream in(text);
+  std::vector<double> v;
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::runtime_error("--" + flag + "='" + text + "': expected x,y,z numbers");
+    }
+  }
+  if (v.size() == 1) return ctlio::Vec3::Constant(v[0]);
+  if (v.size() != 3)
+    throw std::runtime_error("--" + flag + "='" + text + "': expected 1 or 3 numbers");
+  return ctlio::Vec3(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   gflags::SetUsageMessage("Write a simulated lidar-inertial dataset folder");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
@@ -46,7 +91,6 @@ int main(int argc, char** argv) {
   try {
     using namespace ctlio;
     const sim::Regime regime = sim::ParseRegime(FLAGS_regime);
-    sim::SimConfig config = sim::ExperimentConfig(regime, FLAGS_index, FLAGS_seed);
     // inf wrote 0 scans with exit 0, nan failed in vector::reserve.
     if (!(FLAGS_duration > 0.0 && FLAGS_duration <= 3600.0)) {
       throw std::runtime_error("--duration must be in (0, 3600] s");
@@ -54,6 +98,28 @@ int main(int argc, char** argv) {
     if (FLAGS_firing_decimation < 1 || FLAGS_beams < 1) {
       throw std::runtime_error("--firing_decimation and --beams must be >= 1");
     }
+    const sim::WorldKind world = sim::ParseWorld(FLAGS_world);
+    if (FLAGS_pillars > 0 && world != sim::WorldKind::kBox) {
+      throw std::runtime_error("--pillars is a box-world option");
+    }
+    sim::SimConfig config = sim::ExperimentConfig(regime, FLAGS_index, FLAGS_seed, world);
+    config.world.seed = FLAGS_world_seed;
+    auto& L = config.lidar;
+    L.range_noise_per_m = FLAGS_range_noise_per_m;
+    L.dropout = FLAGS_lidar_dropout;
+    L.max_incidence_deg = FLAGS_max_incidence_deg;
+    L.reflect_range = FLAGS_reflect_range;
+    L.elevation_error_deg = FLAGS_beam_elevation_error_deg;
+    L.azimuth_error_deg = FLAGS_beam_azimuth_error_deg;
+    auto& I = config.imu;
+    I.accel_scale = ParseVec3("accel_scale", FLAGS_accel_scale);
+    I.gyro_scale = ParseVec3("gyro_scale", FLAGS_gyro_scale);
+    I.accel_limit = FLAGS_accel_limit;
+    I.gyro_limit = FLAGS_gyro_limit;
+    I.outages = sim::ParseImuOutages(FLAGS_imu_dropout);
+    I.outage_rate = FLAGS_imu_outage_rate;
+    I.outage_length_min = FLAGS_imu_outage_min;
+    I.outage_length_max = FLAGS_imu_outage_max;
     config.duration_s = FLAGS_duration;
     config.lidar.firing_decimation = FLAGS_firing_decimation;
     config.lidar.beams = FLAGS_beams;
@@ -76,21 +142,48 @@ int main(int argc, char** argv) {
     }
 
     std::ostringstream yaml;
-    yaml << "{regime: " << FLAGS_regime << ", index: " << FLAGS_index << ", seed: " << FLAGS_seed
+    yaml << "{world: " << FLAGS_world << ", world_seed: " << FLAGS_world_seed
+         << ", regime: " << FLAGS_regime << ", index: " << FLAGS_index << ", seed: " << FLAGS_seed
          << ", duration_s: " << FLAGS_duration << ", firing_decimation: " << FLAGS_firing_decimation
          << ", beams: " << FLAGS_beams
          << ", body_centric: " << (FLAGS_body_centric ? "true" : "false")
-         << ", pillars: " << FLAGS_pillars << ", axes: [";
+         << ", pillars: " << FLAGS_pillars << ", range_noise_per_m: " << FLAGS_range_noise_per_m
+         << ", lidar_dropout: " << FLAGS_lidar_dropout
+         << ", max_incidence_deg: " << FLAGS_max_incidence_deg
+         << ", reflect_range: " << FLAGS_reflect_range
+         << ", beam_elevation_error_deg: " << FLAGS_beam_elevation_error_deg
+         << ", beam_azimuth_error_deg: " << FLAGS_beam_azimuth_error_deg << ", accel_scale: ["
+         << FLAGS_accel_scale << "], gyro_scale: [" << FLAGS_gyro_scale
+         << "], accel_limit: " << FLAGS_accel_limit << ", gyro_limit: " << FLAGS_gyro_limit
+         << ", imu_outage_rate: " << FLAGS_imu_outage_rate << ", imu_outage_length: ["
+         << FLAGS_imu_outage_min << ", " << FLAGS_imu_outage_max << "], axes: [";
     for (int j = 0; j < 6; ++j) {
       yaml << (j ? ", " : "") << "[" << config.motion.axes[j].amplitude << ", "
            << config.motion.axes[j].frequency << "]";
     }
-    yaml << "]}";
+    yaml << "]";
+    if (config.motion.guided) {
+      const sim::GuideProfile& g = config.motion.guide;
+      yaml << ", guide: {start_fraction: " << g.start_fraction << ", speed: " << g.speed
+           << ", height: " << g.height << "}";
+    }
+    yaml << "}";
 
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream name;
-    name << "sim:" << FLAGS_regime << "/" << FLAGS_index;
+    name << "sim:" << (world == sim::WorldKind::kBox ? "" : FLAGS_world + "/") << FLAGS_regime
+         << "/" << FLAGS_index;
     sim::SimulatedSource source(config, name.str());
+    if (!FLAGS_topview.empty()) {
+      sim::WriteTopViewSvg(source.simulator().world(), FLAGS_topview, "world " + FLAGS_world);
+    }
+    if (!source.simulator().ImuOutages().empty()) {
+      std::ostringstream msg;
+      for (const auto& o : source.simulator().ImuOutages()) {
+        msg << " [" << o.start_s << ", " << o.start_s + o.length_s << ") s";
+      }
+      LOG(INFO) << "IMU outages (samples absent):" << msg.str();
+    }
     // Progress on stderr, about every 5 % of the scans.
     auto progress = [&](size_t done, size_t total) {
       if (done != total && done % std::max<size_t>(1, total / 20) != 0) return;

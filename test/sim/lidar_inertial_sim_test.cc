@@ -194,6 +194,51 @@ TEST(LidarInertialSim, RangeNoiseLevelFullResolutionCountAndDeterminism) {
   EXPECT_NE(LidarInertialSim(other).Scan(1).points[12345], cloud.points[12345]);
 }
 
+// FNV-1a over the IMU stream and three scans (every byte of every value).
+uint64_t OutputHash(const SimConfig& c) {
+  const LidarInertialSim sim(c);
+  uint64_t h = 1469598103934665603ULL;
+  auto add = [&h](const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ULL;
+  };
+  for (const auto& m : sim.Imu()) {
+    add(&m.t_ns, 8);
+    add(m.accel.data(), 24);
+    add(m.gyro.data(), 24);
+  }
+  for (size_t k : {0, 5, 13}) {
+    const io::PointCloud cl = sim.Scan(k);
+    for (size_t i = 0; i < cl.size(); ++i) {
+      add(cl.points[i].data(), 24);
+      add(&cl.times_ns[i], 8);
+      add(&cl.ring[i], 2);
+    }
+  }
+  return h;
+}
+
+// The box world with default options is the simulator as it was before the other worlds and
+// the realism options existed: the two hashes were printed by the simulator of commit bdb63a7
+// (the same configurations, built alone from that commit's apps/sim).
+TEST(LidarInertialSim, BoxWorldReproducesThePreviousSimulatorBitForBit) {
+  SimConfig a = ExperimentConfig(Regime::kMedium, 3);
+  a.duration_s = 2.0;
+  a.lidar.beams = 16;
+  a.lidar.firing_decimation = 10;
+  SimConfig b = ExperimentConfig(Regime::kFast, 7, kExperimentSeed, WorldKind::kBox);
+  b.duration_s = 2.0;
+  b.lidar.beams = 32;
+  b.lidar.firing_decimation = 7;
+  b.room.obstacles.push_back({Vec3(3, -1, 0), Vec3(4, 1, 10)});
+  b.imu_from_lidar = SE3(so3::Exp(Vec3(0.1, -0.2, 3.0)), Vec3(0.1, 0.2, -0.05));
+  b.imu.accel_bias_walk = 0.01;
+  b.imu.gyro_bias_walk = 0.001;
+  b.imu.body_centric = true;
+  EXPECT_EQ(OutputHash(a), 0xe60e40d713b7d8c1ULL);
+  EXPECT_EQ(OutputHash(b), 0xcc2dc4f2bf94d806ULL);
+}
+
 TEST(SimulatedSource, PartitionsImuBetweenScansAndHasGroundTruth) {
   SimConfig c = SmallConfig(Regime::kMedium, 2);
   c.imu_from_lidar = SE3(so3::Exp(Vec3(0, 0, M_PI)), Vec3(0.1, 0, 0));

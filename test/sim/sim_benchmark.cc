@@ -1,5 +1,6 @@
 // Simulator speed (issue 8 asks for a 20 s full-resolution sequence in < 30 s on one core).
-// BM_FullSequence generates every scan and IMU sample of fast/00 in memory; BM_Scan one scan.
+// BM_FullSequence generates every scan and IMU sample of fast/00 in memory; BM_Scan one scan;
+// BM_ScanWorld one scan in each world (box, street, corridor, park, indoor).
 #include <benchmark/benchmark.h>
 
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -28,6 +29,25 @@ void BM_Scan(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Scan)->Unit(benchmark::kMillisecond);
+
+// One full-resolution scan (128 beams × 1800 firings = 230,400 rays) per world, medium regime
+// (guided along the path outside the box), sequence 0, scans taken in turn over the first 5 s.
+void BM_ScanWorld(benchmark::State& state) {
+  const auto world = static_cast<ctlio::sim::WorldKind>(state.range(0));
+  ctlio::sim::SimConfig c = ctlio::sim::ExperimentConfig(
+      ctlio::sim::Regime::kMedium, 0, ctlio::sim::kExperimentSeed, world);
+  c.duration_s = 5.0;
+  const ctlio::sim::LidarInertialSim sim(c);
+  size_t k = 0, points = 0;
+  for (auto _ : state) {
+    auto cloud = sim.Scan(k++ % sim.NumScans());
+    points = cloud.size();
+    benchmark::DoNotOptimize(cloud.points.data());
+  }
+  state.SetLabel(ctlio::sim::WorldName(world));
+  state.counters["returns"] = double(points);
+}
+BENCHMARK(BM_ScanWorld)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -4,78 +4,19 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <stdexcept>
+
+#include "ctlio/sim/random_draw.h"
 
 namespace ctlio::sim {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 
-// Uniform in [lo, hi) from the top 53 bits (portable, unlike std::uniform_real_distribution).
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53;
-}
-
 int64_t PeriodNs(double rate_hz) { return std::llround(1e9 / rate_hz); }
 
 }  // namespace
-
-const char* RegimeName(Regime r) {
-  switch (r) {
-    case Regime::kSlow:
-      return "slow";
-    case Regime::kMedium:
-      return "medium";
-    case Regime::kFast:
-      return "fast";
-  }
-  return "?";
-}
-
-Regime ParseRegime(const std::string& name) {
-  if (name == "slow") return Regime::kSlow;
-  if (name == "medium") return Regime::kMedium;
-  if (name == "fast") return Regime::kFast;
-  throw std::runtime_error("unknown regime '" + name + "' (expected slow, medium or fast)");
-}
-
-MotionProfile DrawMotion(Regime regime, int index, uint64_t seed) {
-  struct Range {
-    double amp_lo, amp_hi, f_lo, f_hi;
-  };
-  Range lin{}, ang{};
-  switch (regime) {
-    case Regime::kSlow:
-      lin = {0.1, 0.5, 0.5, 1.0};
-      ang = {0, 0, 0.5, 1.0};
-      break;
-    case Regime::kMedium:
-      lin = {0.5, 1.0, 1.0, 2.0};
-      ang = {0.5, 1.0, 2.0, 4.0};
-      break;
-    case Regime::kFast:
-      lin = {1.0, 2.0, 2.0, 4.0};
-      ang = {1.0, 2.0, 4.0, 8.0};
-      break;
-  }
-  std::seed_seq seq{uint32_t(seed), uint32_t(seed >> 32), uint32_t(regime), uint32_t(index)};
-  std::mt19937_64 rng(seq);
-  MotionProfile m;
-  for (int j = 0; j < 6; ++j) {
-    const Range& r = j < 3 ? lin : ang;
-    m.axes[j].amplitude = Uniform(rng, r.amp_lo, r.amp_hi);
-    m.axes[j].frequency = Uniform(rng, r.f_lo, r.f_hi);
-  }
-  return m;
-}
-
-SimConfig ExperimentConfig(Regime regime, int index, uint64_t seed) {
-  SimConfig c;
-  c.motion = DrawMotion(regime, index, seed);
-  // A different stream for the noise: {seed, regime, index} mixed by SplitMix64's constant.
-  c.seed = seed ^ (0x9E3779B97F4A7C15ULL * (uint64_t(regime) * 1000 + uint64_t(index) + 1));
-  return c;
-}
 
 LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   const auto& L = config_.lidar;
@@ -83,18 +24,37 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
       config_.imu.rate_hz <= 0 || config_.duration_s <= 0 || config_.integration_step_s <= 0) {
     throw std::runtime_error("LidarInertialSim: invalid configuration (non-positive rate/count)");
   }
-  // Ground-truth pose grid.
+  const auto& I = config_.imu;
+  if (L.dropout < 0 || L.dropout > 1 || L.max_incidence_deg <= 0 || L.max_incidence_deg > 90 ||
+      L.reflect_range < 0 || L.range_noise_per_m < 0 || L.elevation_error_deg < 0 ||
+      L.azimuth_error_deg < 0 || I.accel_limit < 0 || I.gyro_limit < 0 || I.outage_rate < 0 ||
+      (I.outage_rate > 0 &&
+       !(I.outage_length_min > 0 && I.outage_length_min <= I.outage_length_max))) {
+    throw std::runtime_error(
+        "LidarInertialSim: invalid realism option (dropout in [0, 1], incidence in (0, 90] deg, "
+        "ranges, errors, limits and rates ≥ 0, 0 < outage length min ≤ max)");
+  }
+  world_ = BuildWorld(config_.world, config_.room);
+  const bool guided = config_.motion.guided;
+  if (guided && PeakSpeed(config_.motion.guide) > world_.max_speed) {
+    std::ostringstream msg;
+    msg << "LidarInertialSim: world '" << WorldName(config_.world.kind) << "' allows at most "
+        << world_.max_speed << " m/s along its path, the motion asks for "
+        << PeakSpeed(config_.motion.guide) << " m/s (the vehicle regime needs box, street or park)";
+    throw std::runtime_error(msg.str());
+  }
+  path_start_ = config_.motion.guide.start_fraction * world_.start_range;
+  // Ground-truth pose grid (of P alone when guided).
   const double h = config_.integration_step_s;
   const size_t n = size_t(std::ceil(config_.duration_s / h)) + 2;
   grid_.reserve(n);
-  grid_.push_back(config_.world_from_imu0);
+  grid_.push_back(guided ? SE3() : config_.world_from_imu0);
   for (size_t i = 1; i < n; ++i) grid_.push_back(MagnusStep(grid_.back(), double(i - 1) * h, h));
 
   // IMU stream: one generator for noise and bias walk, drawn in sample order.
   std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xC7u};
   std::mt19937_64 rng(seq);
   std::normal_distribution<double> normal;
-  const auto& I = config_.imu;
   const int64_t dt_ns = PeriodNs(I.rate_hz);
   const double dt = 1e-9 * double(dt_ns);
   const int64_t end_ns = config_.start_ns + std::llround(config_.duration_s * 1e9);
@@ -102,10 +62,14 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   bias << I.accel_bias, I.gyro_bias;
   for (int64_t t_ns = config_.start_ns; t_ns <= end_ns; t_ns += dt_ns) {
     io::ImuSample s = TrueImu(Seconds(t_ns));
+    if (!I.accel_scale.isZero()) s.accel = s.accel.cwiseProduct(Vec3::Ones() + I.accel_scale);
+    if (!I.gyro_scale.isZero()) s.gyro = s.gyro.cwiseProduct(Vec3::Ones() + I.gyro_scale);
     for (int k = 0; k < 3; ++k) {
       s.accel[k] += bias[k] + I.accel_noise * normal(rng);
       s.gyro[k] += bias[3 + k] + I.gyro_noise * normal(rng);
     }
+    if (I.accel_limit > 0) s.accel = s.accel.cwiseMax(-I.accel_limit).cwiseMin(I.accel_limit);
+    if (I.gyro_limit > 0) s.gyro = s.gyro.cwiseMax(-I.gyro_limit).cwiseMin(I.gyro_limit);
     imu_.push_back(s);
     biases_.push_back(bias);
     for (int k = 0; k < 3; ++k) {
@@ -114,7 +78,18 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
     }
   }
 
-  // Beam and azimuth tables.
+  ApplyImuOutages();
+
+  // Beam and azimuth tables; fixed beam-angle errors from their own stream.
+  if (L.elevation_error_deg > 0 || L.azimuth_error_deg > 0) {
+    std::seed_seq beam_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xBEA4u};
+    std::mt19937_64 beam_rng(beam_seq);
+    std::normal_distribution<double> beam_normal;
+    for (int b = 0; b < L.beams; ++b) {
+      beam_el_error_.push_back(L.elevation_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
+      beam_az_error_.push_back(L.azimuth_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
+    }
+  }
   for (int b = 0; b < L.beams; ++b) {
     const double el =
         (L.beams == 1 ? L.min_elevation_deg
@@ -132,6 +107,22 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
 }
 
 Vec6 LidarInertialSim::BodyTwist(double t) const {
+  if (!config_.motion.guided) return LocalTwist(t);
+  const PoseRates g =
+      EvaluateGuide(world_.path, config_.motion.guide, config_.motion.start_s, path_start_, t);
+  return LocalPose(t).Inverse().Adjoint() * g.twist + LocalTwist(t);
+}
+
+Vec6 LidarInertialSim::BodyTwistRate(double t) const {
+  if (!config_.motion.guided) return LocalTwistRate(t);
+  const PoseRates g =
+      EvaluateGuide(world_.path, config_.motion.guide, config_.motion.start_s, path_start_, t);
+  const Mat6 ad_inv = LocalPose(t).Inverse().Adjoint();
+  return ad_inv * g.twist_rate - se3::CurlyHat(LocalTwist(t)) * (ad_inv * g.twist) +
+         LocalTwistRate(t);
+}
+
+Vec6 LidarInertialSim::LocalTwist(double t) const {
   Vec6 xi = Vec6::Zero();
   const double s = t - config_.motion.start_s;
   if (s <= 0) return xi;
@@ -142,7 +133,7 @@ Vec6 LidarInertialSim::BodyTwist(double t) const {
   return xi;
 }
 
-Vec6 LidarInertialSim::BodyTwistRate(double t) const {
+Vec6 LidarInertialSim::LocalTwistRate(double t) const {
   Vec6 d = Vec6::Zero();
   const double s = t - config_.motion.start_s;
   if (s < 0) return d;  // right derivative at start_s
@@ -159,13 +150,20 @@ Vec6 LidarInertialSim::BodyTwistRate(double t) const {
 SE3 LidarInertialSim::MagnusStep(const SE3& T, double t, double h) const {
   if (h <= 0) return T;
   const double c = std::sqrt(3.0) / 6.0;
-  const Vec6 a1 = BodyTwist(t + (0.5 - c) * h);
-  const Vec6 a2 = BodyTwist(t + (0.5 + c) * h);
+  const Vec6 a1 = LocalTwist(t + (0.5 - c) * h);
+  const Vec6 a2 = LocalTwist(t + (0.5 + c) * h);
   const Vec6 omega = 0.5 * h * (a1 + a2) + (std::sqrt(3.0) * h * h / 12.0) * se3::CurlyHat(a1) * a2;
   return T * SE3::Exp(omega);
 }
 
 SE3 LidarInertialSim::WorldFromImu(double t) const {
+  if (!config_.motion.guided) return LocalPose(t);
+  return EvaluateGuide(world_.path, config_.motion.guide, config_.motion.start_s, path_start_, t)
+             .pose *
+         LocalPose(t);
+}
+
+SE3 LidarInertialSim::LocalPose(double t) const {
   const double h = config_.integration_step_s;
   if (t <= 0) return grid_.front();
   size_t k = size_t(std::floor(t / h));
@@ -203,6 +201,7 @@ int64_t LidarInertialSim::FiringTimeNs(size_t k, int firing) const {
 }
 
 double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
+  if (config_.world.kind != WorldKind::kBox) return Cast(o, d).t;
   // Inside of the room: the nearest exit through one of the six walls.
   double r = std::numeric_limits<double>::infinity();
   const auto& R = config_.room;
@@ -210,25 +209,47 @@ double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
     if (d[i] > 0) r = std::min(r, (R.max[i] - o[i]) / d[i]);
     if (d[i] < 0) r = std::min(r, (R.min[i] - o[i]) / d[i]);
   }
-  // Obstacles: slab test, entry distance.
-  for (const Box& b : R.obstacles) {
-    double t0 = 0.0, t1 = r;
-    bool hit = true;
-    for (int i = 0; i < 3 && hit; ++i) {
-      if (d[i] == 0.0) {
-        hit = o[i] >= b.min[i] && o[i] <= b.max[i];
-        continue;
-      }
-      const double inv = 1.0 / d[i];
-      double a = (b.min[i] - o[i]) * inv, c = (b.max[i] - o[i]) * inv;
-      if (a > c) std::swap(a, c);
-      t0 = std::max(t0, a);
-      t1 = std::min(t1, c);
-      hit = t0 <= t1;
-    }
-    if (hit && t0 > 0.0) r = std::min(r, t0);
-  }
+  // Obstacles: entry distance (slab test).
+  for (const Box& b : R.obstacles) r = std::min(r, IntersectBox(b, o, d, r).t);
   return r;
+}
+
+RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d) const {
+  const auto& L = config_.lidar;
+  const bool need_normal = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
+  if (config_.world.kind == WorldKind::kBox && !need_normal) return {CastRay(o, d), Vec3::Zero()};
+  // Farther than this no noise draw brings a return back inside max_range.
+  const double reach = L.max_range * (1 + 6 * L.range_noise_per_m) + 6 * L.range_noise + 1.0;
+  return world_.scene.Cast(o, d, reach);
+}
+
+void LidarInertialSim::ApplyImuOutages() {
+  const auto& I = config_.imu;
+  outages_ = I.outages;
+  if (I.outage_rate > 0) {  // Poisson arrivals, uniform lengths, from their own stream
+    std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xD0u};
+    std::mt19937_64 rng(seq);
+    for (double t = 0.0;;) {
+      t += -std::log(1.0 - Uniform(rng, 0, 1)) / I.outage_rate;
+      if (t >= config_.duration_s) break;
+      outages_.push_back({t, Uniform(rng, I.outage_length_min, I.outage_length_max)});
+    }
+  }
+  if (outages_.empty()) return;
+  std::vector<io::ImuSample> kept;
+  std::vector<Vec6> kept_bias;
+  for (size_t j = 0; j < imu_.size(); ++j) {
+    const int64_t t = imu_[j].t_ns - config_.start_ns;
+    const bool out = std::any_of(outages_.begin(), outages_.end(), [t](const ImuOutage& o) {
+      const int64_t a = std::llround(o.start_s * 1e9), b = a + std::llround(o.length_s * 1e9);
+      return t >= a && t < b;
+    });
+    if (out) continue;
+    kept.push_back(imu_[j]);
+    kept_bias.push_back(biases_[j]);
+  }
+  imu_.swap(kept);
+  biases_.swap(kept_bias);
 }
 
 io::PointCloud LidarInertialSim::Scan(size_t k) const {
@@ -244,6 +265,13 @@ io::PointCloud LidarInertialSim::Scan(size_t k) const {
   std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0x11DA7u, uint32_t(k)};
   std::mt19937_64 rng(seq);
   std::normal_distribution<double> normal;
+  // Lost returns draw from their own stream, so the noise stream is the same with or without.
+  std::seed_seq lost_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0x1057u,
+                         uint32_t(k)};
+  std::mt19937_64 lost_rng(lost_seq);
+  const double cos_max_incidence = std::cos(L.max_incidence_deg * M_PI / 180.0);
+  const bool beam_errors = !beam_el_error_.empty();
+  const bool incidence = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
   for (int f = 0; f < L.firings_per_revolution; f += L.firing_decimation) {
     const int64_t t_ns = FiringTimeNs(k, f);
     const SE3 T_wl = WorldFromLidar(Seconds(t_ns));
@@ -251,11 +279,26 @@ io::PointCloud LidarInertialSim::Scan(size_t k) const {
     const Mat3& C = T_wl.rotation();
     for (int b = 0; b < L.beams; ++b) {
       const Vec3 d_l(cos_el_[b] * cos_az_[f], cos_el_[b] * sin_az_[f], sin_el_[b]);
-      const double noise = L.range_noise * normal(rng);  // drawn for every ray: stable streams
-      const double r = CastRay(o, C * d_l);
-      if (!std::isfinite(r)) continue;
-      const double m = r + noise;
+      const double n = normal(rng);  // drawn for every ray: stable streams
+      const double noise = L.range_noise * n;
+      const bool lost = L.dropout > 0.0 && Uniform(lost_rng, 0, 1) < L.dropout;
+      Vec3 d_ray = d_l;  // the true ray direction
+      if (beam_errors) {
+        const double el = std::asin(sin_el_[b]) + beam_el_error_[b];
+        const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
+        d_ray = Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      }
+      const RayHit hit = Cast(o, C * d_ray);
+      const double r = hit.t;
+      if (!std::isfinite(r) || lost) continue;
+      const double m =
+          L.range_noise_per_m > 0.0 ? r + noise + L.range_noise_per_m * r * n : r + noise;
       if (m < L.min_range || m > L.max_range) continue;
+      if (incidence) {
+        const double cos_incidence = std::abs(hit.normal.dot(C * d_ray));
+        if (cos_incidence < cos_max_incidence) continue;
+        if (L.reflect_range > 0.0 && r > L.reflect_range * std::sqrt(cos_incidence)) continue;
+      }
       cloud.points.push_back(m * d_l);
       cloud.times_ns.push_back(t_ns);
       cloud.ring.push_back(uint16_t(b));

@@ -34,11 +34,15 @@ Mat3 SqrtInformation(const Mat3& covariance) {
 }
 
 ImuGyroMeasurement::ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
-                                       double tau, const Vec3& gyro, const Mat3& covariance)
+                                       double tau, const Vec3& gyro, const Mat3& covariance,
+                                       const ImuMounting& mounting)
     : interpolator_(model, t_k, t_k1, tau),
       s_(Fraction(t_k, t_k1, tau)),
       gyro_(gyro),
-      sqrt_information_(SqrtInformation(covariance)) {}
+      sqrt_information_(SqrtInformation(covariance)),
+      C_ir_(mounting.C_ri.transpose()),
+      S_C_ir_(sqrt_information_ * C_ir_),
+      rotated_(mounting.HasRotation()) {}
 
 bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
@@ -55,13 +59,14 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
                           need_knots ? &J_k1 : nullptr);
 
   const Vec3 bg = (1.0 - s_) * b_k.tail<3>() + s_ * b_k1.tail<3>();
-  Eigen::Map<Vec3>{residuals} = sqrt_information_ * (gyro_ + x.velocity.tail<3>() - bg);
+  const Vec3 w_imu = rotated_ ? Vec3(C_ir_ * x.velocity.tail<3>()) : Vec3(x.velocity.tail<3>());
+  Eigen::Map<Vec3>{residuals} = sqrt_information_ * (gyro_ + w_imu - bg);
   if (jacobians == nullptr) return true;
 
   if (need_knots) {
-    // D = [0 … I at ϖ_ω … 0]: rows 9–11 of the state Jacobians.
-    const Row3x18 DJ_k = sqrt_information_ * J_k.middleRows<3>(9);
-    const Row3x18 DJ_k1 = sqrt_information_ * J_k1.middleRows<3>(9);
+    // D = [0 … C_ir at ϖ_ω … 0]: rows 9–11 of the state Jacobians.
+    const Row3x18 DJ_k = S_C_ir_ * J_k.middleRows<3>(9);
+    const Row3x18 DJ_k1 = S_C_ir_ * J_k1.middleRows<3>(9);
     WriteKnotJacobians(DJ_k, parameters[0], jacobians[0], jacobians[1], jacobians[2]);
     WriteKnotJacobians(DJ_k1, parameters[3], jacobians[3], jacobians[4], jacobians[5]);
   }
@@ -76,13 +81,19 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
 
 ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
                                          double tau, const Vec3& accel, const Mat3& covariance,
-                                         double gravity, AccelModel accel_model)
+                                         double gravity, AccelModel accel_model,
+                                         const ImuMounting& mounting)
     : interpolator_(model, t_k, t_k1, tau),
       s_(Fraction(t_k, t_k1, tau)),
       accel_(accel),
       sqrt_information_(SqrtInformation(covariance)),
       gravity_i_(0.0, 0.0, -gravity),
-      accel_model_(accel_model) {}
+      accel_model_(accel_model),
+      C_ir_(mounting.C_ri.transpose()),
+      S_C_ir_(sqrt_information_ * C_ir_),
+      rotated_(mounting.HasRotation()),
+      lever_arm_(mounting.lever_arm),
+      lever_arm_nonzero_(mounting.HasLeverArm()) {}
 
 bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
@@ -95,9 +106,12 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
     for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
   }
   const bool exact = accel_model_ == AccelModel::kSpecificForce;
-  // Only the rows D reads (below) are written: δφ and ϖ̇_v, and ϖ for the exact model.
+  const bool lever = lever_arm_nonzero_;
+  // Only the rows D reads (below) are written: δφ and ϖ̇_v, ϖ for the exact model, ϖ_ω and ϖ̇_ω
+  // for a lever arm.
   const unsigned rows = gp::kRotationRows | gp::kLinearAccelerationRows |
-                        (exact ? gp::kLinearVelocityRows | gp::kAngularVelocityRows : 0u);
+                        (exact ? gp::kLinearVelocityRows | gp::kAngularVelocityRows : 0u) |
+                        (lever ? gp::kAngularVelocityRows | gp::kAngularAccelerationRows : 0u);
   gp::KnotState x;
   gp::StateJacobian J_k, J_k1;
   interpolator_.StateRows(k, k1, rows, &x, need_knots ? &J_k : nullptr,
@@ -108,22 +122,30 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
   const Vec3 g_r = C * g_m;
   const Vec3 w_v = x.velocity.head<3>(), w_w = x.velocity.tail<3>();
   const Vec3 ba = (1.0 - s_) * b_k.head<3>() + s_ * b_k1.head<3>();
-  Vec3 e = accel_ + x.acceleration.head<3>() + g_r - ba;
-  if (exact) e -= w_w.cross(w_v);
+  // e = f_m + C_ir e_r − b_a, e_r the robot-frame terms (header), summed in this order so that
+  // the default mounting reproduces the robot-frame residual to the last bit.
+  const auto to_imu = [this](const Vec3& v) { return rotated_ ? Vec3(C_ir_ * v) : v; };
+  Vec3 e = accel_ + to_imu(x.acceleration.head<3>()) + to_imu(g_r) - ba;
+  if (exact) e -= to_imu(w_w.cross(w_v));
+  if (lever) {
+    e -= to_imu(lever_arm_.cross(x.acceleration.tail<3>()) + w_w.cross(w_w.cross(lever_arm_)));
+  }
   Eigen::Map<Vec3>{residuals} = sqrt_information_ * e;
   if (jacobians == nullptr) return true;
 
   if (need_knots) {
-    // D·J = −(g_r)^·J[δφ rows] + J[ϖ̇_v rows] (− ϖ_ω^ J[ϖ_v rows] + ϖ_v^ J[ϖ_ω rows]).
+    // D·J = C_ir [−(g_r)^·J[δφ rows] + J[ϖ̇_v rows] (− ϖ_ω^ J[ϖ_v rows] + ϖ_v^ J[ϖ_ω rows])
+    //             (− p^ J[ϖ̇_ω rows] + ((ϖ_ω×p)^ + ϖ_ω^ p^) J[ϖ_ω rows])].
     const Mat3 G = -so3::Hat(g_r);
+    Mat3 W = exact ? Mat3(so3::Hat(w_v)) : Mat3::Zero();  // ∂e_r/∂ϖ_ω
+    if (lever) W += so3::Hat(w_w.cross(lever_arm_)) + so3::Hat(w_w) * so3::Hat(lever_arm_);
     const auto chain = [&](const gp::StateJacobian& J) {
       Row3x18 DJ = J.middleRows<3>(12);
       DJ.noalias() += G * J.middleRows<3>(3);
-      if (exact) {
-        DJ.noalias() -= so3::Hat(w_w) * J.middleRows<3>(6);
-        DJ.noalias() += so3::Hat(w_v) * J.middleRows<3>(9);
-      }
-      return Row3x18(sqrt_information_ * DJ);
+      if (exact) DJ.noalias() -= so3::Hat(w_w) * J.middleRows<3>(6);
+      if (exact || lever) DJ.noalias() += W * J.middleRows<3>(9);
+      if (lever) DJ.noalias() -= so3::Hat(lever_arm_) * J.middleRows<3>(15);
+      return Row3x18(S_C_ir_ * DJ);
     };
     WriteKnotJacobians(chain(J_k), parameters[0], jacobians[0], jacobians[1], jacobians[2]);
     WriteKnotJacobians(chain(J_k1), parameters[3], jacobians[3], jacobians[4], jacobians[5]);
@@ -135,7 +157,7 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
     J.rightCols<3>().setZero();
   }
   if (jacobians[8] != nullptr) {
-    const Mat3 J_psi = -sqrt_information_ * C * so3::Hat(g_m);
+    const Mat3 J_psi = -S_C_ir_ * C * so3::Hat(g_m);
     LiftRotationJacobian<3>(J_psi, parameters[8], jacobians[8]);
   }
   return true;

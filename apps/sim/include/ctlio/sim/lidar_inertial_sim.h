@@ -10,7 +10,15 @@
 //                 accel = v̇ + ω×v − C_wbᵀ g_w + b_a + n_a   (exact specific force), or
 //                 accel = v̇       − C_wbᵀ g_w + b_a + n_a   (`body_centric`: the paper's model).
 // Motion (SPEC §6): stationary until `start_s`, then each of the six body-twist axes j follows
-// amp_j·sin(2π f_j (t − start_s)), so the twist is continuous at start_s.
+// amp_j·sin(2π f_j (t − start_s)), so the twist is continuous at start_s. Outside the box room
+// (and for the walking and vehicle regimes everywhere) the motion is guided along the world's
+// path (guided_motion.h): T_wb(t) = G(t)·P(t), G the guided pose, P the body-rate motion above
+// integrated from the identity; then [v; ω] = Ad(P⁻¹)ξ_G + ξ_P and
+// d/dt[v; ω] = Ad(P⁻¹)ξ̇_G − ξ_P^⋏·Ad(P⁻¹)ξ_G + ξ̇_P.
+//
+// Sensor realism (all off by default): range-dependent noise, lost returns (random dropout,
+// grazing incidence, weak echoes), fixed per-beam angle errors; IMU scale-factor errors,
+// saturation and outages (samples absent). See LidarConfig and ImuConfig.
 //
 // Determinism: everything derives from SimConfig::seed through std::seed_seq; a scan is a pure
 // function of (seed, scan index), so scans can be generated in any order and in memory.
@@ -23,15 +31,18 @@
 
 #include "ctlio/io/dataset.h"
 #include "ctlio/manifolds/se3.h"
+#include "ctlio/sim/guided_motion.h"
+#include "ctlio/sim/worlds.h"
 
 namespace ctlio::sim {
 
 // The seed of the documented experiment: arXiv 2403.05968 (the paper).
 inline constexpr uint64_t kExperimentSeed = 2403059680ULL;
 
-enum class Regime { kSlow, kMedium, kFast };
+enum class Regime { kSlow, kMedium, kFast, kWalking, kVehicle };
 const char* RegimeName(Regime r);
-Regime ParseRegime(const std::string& name);  // "slow" | "medium" | "fast"; throws otherwise
+// "slow" | "medium" | "fast" | "walking" | "vehicle"; throws otherwise.
+Regime ParseRegime(const std::string& name);
 
 struct AxisMotion {
   double amplitude = 0.0;  // m/s or rad/s
@@ -41,24 +52,24 @@ struct AxisMotion {
 struct MotionProfile {
   std::array<AxisMotion, 6> axes{};  // [v_x v_y v_z ω_x ω_y ω_z]
   double start_s = 0.2;              // stationary before this time
+  bool guided = false;               // carried along the world's path by `guide`
+  GuideProfile guide;
 };
 
 // Draws the six axes of sequence `index` of a regime (SPEC §6): slow: linear U(0.1, 0.5) m/s @
 // U(0.5, 1) Hz, no rotation; medium: linear U(0.5, 1) @ U(1, 2), angular U(0.5, 1) rad/s @
 // U(2, 4); fast: linear U(1, 2) @ U(2, 4), angular U(1, 2) @ U(4, 8). Axis j of sequence i uses
 // std::seed_seq{seed, regime, i} (mt19937_64), amplitude then frequency, axes in order.
+// Walking and vehicle (guided; same stream, draws in this order): walking: start fraction
+// U(0, 1), speed U(1.2, 1.6) m/s, step frequency f U(1.7, 2.1) Hz, vertical bob U(2, 4) cm @ f,
+// lateral sway U(2, 4) cm @ f/2, speed wave U(0.05, 0.15) m/s @ f, head turns U(0.2, 0.5) rad @
+// U(0.1, 0.3) Hz and U(0.05, 0.15) rad @ U(0.5, 1) Hz, pitch U(0.03, 0.08) rad @ f, roll
+// U(0.02, 0.05) rad @ f/2; sensor 1.6 m above the floor, 1 s start ramp. Vehicle: start fraction,
+// speed U(8, 14) m/s, speed wave U(0.5, 1.5) m/s @ U(0.02, 0.06) Hz, lane wander U(0.05, 0.2) m @
+// U(0.05, 0.1) Hz, suspension U(0.5, 1.5) cm @ U(1, 2) Hz, pitch and roll U(0.005, 0.015) rad @
+// U(0.8, 1.5) Hz, yaw jitter U(0.002, 0.006) rad @ U(0.3, 0.6) Hz; sensor 1.9 m high, start ramp
+// speed / 2.5 m/s² long.
 MotionProfile DrawMotion(Regime regime, int index, uint64_t seed = kExperimentSeed);
-
-struct Box {
-  Vec3 min = Vec3::Zero();
-  Vec3 max = Vec3::Zero();
-};
-
-struct RoomConfig {
-  Vec3 min = Vec3(-50, -50, 0);  // walls x, y ∈ [−50, 50], floor 0, ceiling 10
-  Vec3 max = Vec3(50, 50, 10);
-  std::vector<Box> obstacles;  // optional interior boxes / pillars
-};
 
 struct LidarConfig {
   int beams = 128;
@@ -70,7 +81,26 @@ struct LidarConfig {
   double min_range = 0.3;     // returns closer than this are dropped
   double max_range = 200.0;   // and farther than this
   int firing_decimation = 1;  // keep every n-th firing (all beams of a kept firing)
+  // Realism (defaults off). σ(r) = range_noise + range_noise_per_m·r.
+  double range_noise_per_m = 0.0;
+  double dropout = 0.0;             // probability that a return is lost at random
+  double max_incidence_deg = 90.0;  // returns hitting a surface more obliquely are lost
+  // Weak echoes: received power ∝ cos θ / r², so a return needs r ≤ reflect_range·√cos θ
+  // (θ = incidence angle); 0 = off.
+  double reflect_range = 0.0;
+  // Fixed per-beam angle errors (σ, degrees): the ray leaves at the true angles, the point is
+  // reported along the nominal ones (an uncalibrated sensor).
+  double elevation_error_deg = 0.0;
+  double azimuth_error_deg = 0.0;
 };
+
+// An interval without IMU samples, in seconds since the sequence start: [start, start + length).
+struct ImuOutage {
+  double start_s = 0.0;
+  double length_s = 0.0;
+};
+// "5.0:0.5,12:2" → {{5, 0.5}, {12, 2}}; throws on malformed text.
+std::vector<ImuOutage> ParseImuOutages(const std::string& text);
 
 struct ImuConfig {
   double rate_hz = 200.0;
@@ -82,23 +112,39 @@ struct ImuConfig {
   double gyro_bias_walk = 0.0;   // [rad/s / √s]
   bool body_centric = false;     // the paper's model (no ω×v) instead of the exact specific force
   double gravity = 9.81;
+  // Realism (defaults off). Reading = clamp((1 + s)∘truth + b + n, ±limit) per axis, s the
+  // scale-factor error; limit 0 = no saturation.
+  Vec3 accel_scale = Vec3::Zero();
+  Vec3 gyro_scale = Vec3::Zero();
+  double accel_limit = 0.0;  // [m/s²]
+  double gyro_limit = 0.0;   // [rad/s]
+  // Outages: the samples inside are absent (in memory and in every layout written). Given
+  // intervals, plus random ones: a Poisson process of `outage_rate` per second over the sequence
+  // with lengths U(outage_length_min, outage_length_max).
+  std::vector<ImuOutage> outages;
+  double outage_rate = 0.0;
+  double outage_length_min = 0.1, outage_length_max = 1.0;
 };
 
 struct SimConfig {
-  RoomConfig room;
+  RoomConfig room;    // the box world
+  WorldConfig world;  // which world (box by default)
   LidarConfig lidar;
   ImuConfig imu;
   MotionProfile motion;
   double duration_s = 20.0;
   int64_t start_ns = 0;                                        // absolute time of t = 0
-  SE3 world_from_imu0 = SE3(Mat3::Identity(), Vec3(0, 0, 2));  // initial pose T_wb(0)
+  SE3 world_from_imu0 = SE3(Mat3::Identity(), Vec3(0, 0, 2));  // T_wb(0) (unguided motion)
   SE3 imu_from_lidar;                                          // T_bl (identity by default)
   uint64_t seed = kExperimentSeed;                             // noise seed
   double integration_step_s = 1e-4;                            // ground-truth pose grid
 };
 
 // The configuration of sequence `index` of a regime: DrawMotion + noise seed {seed, regime, index}.
-SimConfig ExperimentConfig(Regime regime, int index, uint64_t seed = kExperimentSeed);
+// In a world other than the box, slow/medium/fast are guided along its path at 0.5/1/1.5 m/s,
+// 1.5 m above the floor, from a start fraction drawn from {seed, regime, index, 0x57A7}.
+SimConfig ExperimentConfig(Regime regime, int index, uint64_t seed = kExperimentSeed,
+                           WorldKind world = WorldKind::kBox);
 
 class LidarInertialSim {
  public:
@@ -129,14 +175,28 @@ class LidarInertialSim {
 
   // Range along a unit ray from a world point (interior of the room, nearest obstacle), or +inf.
   double CastRay(const Vec3& origin, const Vec3& direction) const;
+  // The world's geometry and path; the realised IMU outages (given and random).
+  const World& world() const { return world_; }
+  const std::vector<ImuOutage>& ImuOutages() const { return outages_; }
 
  private:
   SimConfig config_;
-  std::vector<SE3> grid_;  // T_wb at multiples of integration_step_s
+  World world_;
+  double path_start_ = 0.0;  // arc length where the guided motion starts
+  std::vector<ImuOutage> outages_;
+  std::vector<double> beam_el_error_, beam_az_error_;  // radians, per beam
+  std::vector<SE3> grid_;                              // T_wb at multiples of integration_step_s
   std::vector<io::ImuSample> imu_;
   std::vector<Vec6> biases_;
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
   SE3 MagnusStep(const SE3& T, double t, double h) const;
+  // The body-rate motion P (SPEC §6 sinusoids) and its pose integrated on the grid.
+  Vec6 LocalTwist(double t) const;
+  Vec6 LocalTwistRate(double t) const;
+  SE3 LocalPose(double t) const;
+  // The nearest surface along a ray (normals only where realism needs them in the box room).
+  RayHit Cast(const Vec3& o, const Vec3& d) const;
+  void ApplyImuOutages();
 };
 
 // The simulator as a data source, generating each scan in memory when asked (SPEC §6: a

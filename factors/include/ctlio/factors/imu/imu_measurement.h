@@ -6,8 +6,10 @@
 //
 // Conventions (SPEC §1): T = T_rm (robot ← map), ϖ = −[v; ω] the negated body
 // twist in the robot frame ([ρ; φ] order: ϖ_v = ϖ.head<3>, ϖ_ω = ϖ.tail<3>),
-// b = [b_a; b_g]. The IMU frame is the robot frame. Gravity g_i = [0, 0, −|g|]
-// in a gravity-aligned frame i; C_mi rotates i into the map frame.
+// b = [b_a; b_g]. Gravity g_i = [0, 0, −|g|] in a gravity-aligned frame i; C_mi
+// rotates i into the map frame. By default the IMU frame is the robot frame; an
+// ImuMounting (imu_mounting.h: C_ri, lever arm p) places it elsewhere, and the
+// measurement, its noise and its bias are then in the IMU's own frame.
 //
 // Gyro:  e_g = ω_m + ϖ_ω(τ) − b_g(τ)                        (ω = −ϖ_ω)
 // Accelerometer. The IMU reads f = C_rm(p̈ − g_m) = v̇_b + ω×v_b − C_rm g_m with
@@ -16,6 +18,11 @@
 //                 e_a = f_m + ϖ̇_v(τ) + C_rm(τ) C_mi g_i − b_a(τ)
 //   kSpecificForce (exact):
 //                 e_a = f_m + ϖ̇_v(τ) − ϖ_ω(τ)×ϖ_v(τ) + C_rm(τ) C_mi g_i − b_a(τ)
+// With a mounting (rigid-body kinematics, imu_mounting.h; ω = −ϖ_ω, ω̇ = −ϖ̇_ω):
+//   e_g = ω_m + C_ir ϖ_ω(τ) − b_g(τ)
+//   e_a = f_m + C_ir [ϖ̇_v + C_rm C_mi g_i (− ϖ_ω×ϖ_v) − p×ϖ̇_ω − ϖ_ω×(ϖ_ω×p)] − b_a
+// (the last two terms are −ω̇×p − ω×(ω×p), in both accelerometer models: they are the
+// rigid-body motion of the IMU's origin, not the ω×v the paper's model leaves out).
 // Both residuals are whitened by S with SᵀS = Σ⁻¹ (Σ the 3×3 sample covariance);
 // the robust loss (the paper: Cauchy, scale 1, on the whitened accelerometer
 // error) is the caller's choice in AddResidualBlock.
@@ -26,8 +33,10 @@
 //   gyro:  ∂e_g/∂ϖ_ω = I;
 //   accel: ∂e_a/∂δφ = −(C C_mi g_i)^, ∂e_a/∂ϖ̇_v = I, and for kSpecificForce
 //          ∂e_a/∂ϖ_v = −ϖ_ω^, ∂e_a/∂ϖ_ω = ϖ_v^;
+//   mounting: every row above is premultiplied by C_ir, and the lever arm adds
+//          ∂e_a/∂ϖ̇_ω = −C_ir p^, ∂e_a/∂ϖ_ω += C_ir [(ϖ_ω×p)^ + ϖ_ω^ p^];
 //   gravity rotation C_mi ← Exp(ψ)C_mi: ∂e_a/∂ψ = −C (C_mi g_i)^ (lifted with
-//          LiftRotationJacobian; hold the block constant with
+//          LiftRotationJacobian, premultiplied by C_ir; hold the block constant with
 //          Problem::SetParameterBlockConstant when C_mi is not estimated);
 //   biases: ∂e/∂b_k = −(1 − s)·P, ∂e/∂b_{k+1} = −s·P, P selecting b_a or b_g.
 //
@@ -41,6 +50,7 @@
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/imu/imu_mounting.h"
 #include "ctlio/manifolds/types.h"
 
 namespace ctlio::imu {
@@ -58,7 +68,8 @@ class ImuGyroMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 
  public:
   // gyro: ω_m (rad/s) at time tau; covariance: of one sample (rad²/s²).
   ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1, double tau,
-                     const Vec3& gyro, const Mat3& covariance);
+                     const Vec3& gyro, const Mat3& covariance,
+                     const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -68,15 +79,18 @@ class ImuGyroMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 
   double s_;  // (τ − t_k)/(t_{k+1} − t_k)
   Vec3 gyro_;
   Mat3 sqrt_information_;
+  Mat3 C_ir_;    // robot → IMU rotation
+  Mat3 S_C_ir_;  // S·C_ir
+  bool rotated_;
 };
 
-class ImuAccelMeasurement final
-    : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 6, 6, 6, 6, 4> {
+class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 6, 6, 6, 6, 4> {
  public:
   // accel: f_m (m/s²) at time tau; covariance of one sample; gravity: |g|.
   ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1, double tau,
                       const Vec3& accel, const Mat3& covariance, double gravity = 9.81,
-                      AccelModel accel_model = AccelModel::kBodyCentric);
+                      AccelModel accel_model = AccelModel::kBodyCentric,
+                      const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -88,6 +102,11 @@ class ImuAccelMeasurement final
   Mat3 sqrt_information_;
   Vec3 gravity_i_;
   AccelModel accel_model_;
+  Mat3 C_ir_;    // robot → IMU rotation
+  Mat3 S_C_ir_;  // S·C_ir
+  bool rotated_;
+  Vec3 lever_arm_;  // p
+  bool lever_arm_nonzero_;
 };
 
 }  // namespace ctlio::imu
