@@ -207,6 +207,38 @@ TEST(ReaderHardening, FarPointTimeOnTheLastScanDoesNotStretchIt) {
   EXPECT_EQ(frames[2].end_ns - frames[2].start_ns, 50'000'000);
 }
 
+// A folder written with an IMU outage (0.6 s, as in the dropout experiments) reads back in both
+// layouts with every sample and its hole: the gap is a warning unless the opt-in limit is set.
+TEST(ReaderHardening, FolderWithAnImuOutageReadsBack) {
+  sim::SimConfig c = TinySim();
+  c.duration_s = 1.0;
+  c.imu.outages = {{0.3, 0.6}};
+  size_t samples = 0;
+  {
+    sim::SimulatedSource truth(c);
+    for (const auto& f : ReadAll(truth)) samples += f.imu.size();
+  }
+  const fs::path a = testing::FreshTempDir("harden_outage_ctlio");
+  const fs::path b = testing::FreshTempDir("harden_outage_nc");
+  sim::SimulatedSource sa(c), sb(c);
+  WriteSimFolder(sa, a.string());
+  WriteNewerCollege(sb, b.string());
+  for (const fs::path& d : {a, b}) {
+    auto reader = OpenDataset(d.string());
+    size_t read = 0;
+    int64_t widest = 0, last = 0;
+    for (const auto& f : ReadAll(*reader)) {
+      for (const auto& s : f.imu) {
+        if (read++ > 0) widest = std::max(widest, s.t_ns - last);
+        last = s.t_ns;
+      }
+    }
+    EXPECT_EQ(read, samples) << d;
+    EXPECT_NEAR(double(widest), 0.6e9, 0.01e9) << d;
+    ExpectError([&] { OpenDataset(d.string(), 100'000'000); }, {"gap of 0.6"});
+  }
+}
+
 TEST(ReaderHardening, NewerCollegeWriterRefusesAnExtrinsicTheLayoutCannotCarry) {
   sim::SimConfig c = TinySim();
   c.imu_from_lidar = SE3();
