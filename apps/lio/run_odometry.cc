@@ -112,11 +112,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
-    for (const io::ImuSample& s : frame.imu) {
-      lio::ImuSample x;  // = imu::ImuSample
-      x.t_ns = s.t_ns;
-      x.gyro = s.gyro;
-      x.accel = s.accel;
+    for (const io::ImuSample& x : frame.imu) {
       if (const auto why = lio::CheckImuRange(x, checks)) {
         if (++run.imu_rejected <= 5) {
           warn("IMU sample at " + io::FormatSecondsNs(x.t_ns) + " s rejected: " + *why);
