@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "ctlio/eval/trajectory_metrics.h"
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/trajectory_io.h"
 
 #ifndef CTLIO_TOOLS_DIR
@@ -116,10 +117,11 @@ int main(int argc, char** argv) {
       namespace fs = std::filesystem;
       const fs::path out(FLAGS_output_dir);
       fs::create_directories(out);
-      std::ofstream(out / "metrics.txt") << text;
-      std::ofstream(out / "metrics.json") << ev::ReportJson(report);
+      io::WriteTextFile((out / "metrics.txt").string(), text);
+      io::WriteTextFile((out / "metrics.json").string(), ev::ReportJson(report));
       {
-        std::ofstream csv(out / "errors.csv");
+        const std::string csv_path = (out / "errors.csv").string();
+        std::ofstream csv = io::OpenForWriting(csv_path);
         csv << "t_s,est_x,est_y,est_z,ref_x,ref_y,ref_z,error_m\n";
         csv.precision(12);
         const auto& a = report.ate;
@@ -129,6 +131,7 @@ int main(int argc, char** argv) {
               << a.reference[k].x() << ',' << a.reference[k].y() << ',' << a.reference[k].z() << ','
               << a.errors[k] << '\n';
         }
+        io::CloseChecked(csv, csv_path);
       }
       std::cout << "wrote " << (out / "metrics.txt").string() << ", metrics.json, errors.csv\n";
       if (FLAGS_plot) {
@@ -144,7 +147,9 @@ int main(int argc, char** argv) {
           if (std::system(cmd.c_str()) == 0) {
             std::cout << "wrote top_view.png, error_over_time.png\n";
           } else {
-            std::cout << "plots skipped: the plot script failed (" << cmd << ")\n";
+            // The plots were asked for and python is there: a failure (e.g. a full disk) is an
+            // error, not a silently missing PNG.
+            throw std::runtime_error(out.string() + ": the plot script failed (" + cmd + ")");
           }
         }
       }

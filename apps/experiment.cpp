@@ -24,6 +24,7 @@
 #include <thread>
 #include <tuple>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
@@ -86,7 +87,7 @@ void WriteBarSvg(const std::string& path,
   const auto y_of = [&](double cm) {
     return bottom - (std::log10(cm) - lo) / (hi - lo) * (bottom - top);
   };
-  std::ofstream f(path);
+  std::ofstream f = io::OpenForWriting(path);
   f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width << "' height='" << height
     << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
        "fill='white'/>\n<text x='"
@@ -123,6 +124,7 @@ void WriteBarSvg(const std::string& path,
       << left + 26 + 150 * m << "' y='" << height - 20 << "'>" << methods[m] << "</text>\n";
   }
   f << "</svg>\n";
+  io::CloseChecked(f, path);
 }
 
 }  // namespace
@@ -196,7 +198,7 @@ int main(int argc, char** argv) {
     for (auto& t : pool) t.join();
 
     // Per run.
-    std::ofstream csv(FLAGS_out + "/results.csv");
+    std::ofstream csv = io::OpenForWriting(FLAGS_out + "/results.csv");
     csv << "regime,sequence,method,ate_rmse_m,ate_pairs,failed_scans,degenerate_scans,failure,"
            "median_ms,p95_ms,max_ms,median_cpu_ms,p95_cpu_ms,error\n";
     for (const Job& j : jobs) {
@@ -207,6 +209,7 @@ int main(int argc, char** argv) {
           << ',' << j.run.p95_ms << ',' << j.run.max_ms << ',' << j.run.median_cpu_ms << ','
           << j.run.p95_cpu_ms << ",\"" << j.error << "\"\n";
     }
+    io::CloseChecked(csv, FLAGS_out + "/results.csv");
     // Table: overall RMSE = sqrt(Σ n_i·rmse_i² / Σ n_i) over the runs of a regime that did not
     // fail (so one diverged run is counted as a failure and does not swamp the mean), and the
     // same over all runs for completeness.
@@ -262,7 +265,7 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     md << "\nWall time " << el << " s on " << threads << " threads. A failure is a run with a "
        << "failed scan or an ATE above " << FLAGS_failure_ate << " m.\n";
-    std::ofstream(FLAGS_out + "/table.md") << md.str();
+    io::WriteTextFile(FLAGS_out + "/table.md", md.str());
     std::printf("%s", md.str().c_str());
     WriteBarSvg(FLAGS_out + "/table2.svg", bars, regimes, methods);
     return 0;

@@ -15,11 +15,15 @@
 // DIR/odometry.png (top and side view in metres, errors and per-scan time/status over time) and,
 // for several methods, DIR/comparison.png; without matplotlib an SVG top view
 // (trajectory_topview.svg) instead. Several methods separated by commas run one after the other
-// and print their ATE side by side.
+// and print their ATE side by side. Every write is checked (a full disk or an unwritable path is
+// an error naming the path, exit 2); the input gates of lio/input_checks.h apply (config section
+// `input:`), and --max_imu_gap_error makes IMU gaps in the dataset files an error instead of a
+// warning (README, "IMU gaps").
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -29,13 +33,16 @@
 #include <memory>
 #include <sstream>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
+#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/lio/yaml_io.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
@@ -62,7 +69,11 @@ DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
 DEFINE_string(config, "", "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml)");
 DEFINE_string(out, "", "Output folder (created); with several methods one subfolder per method");
-DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all)");
+DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all; negative is an error)");
+DEFINE_double(max_imu_gap_error, 0.0,
+              "Readers: an IMU gap longer than this [s] is an error naming file and line; 0 = off "
+              "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
+              "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
@@ -75,7 +86,8 @@ namespace {
 
 using namespace ctlio;
 
-std::unique_ptr<io::DataSource> OpenSource() {
+std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
+  const int64_t gap_ns = std::llround(max_imu_gap_error_s * 1e9);
   if (FLAGS_format == "sim") {
     sim::SimConfig c =
         sim::ExperimentConfig(sim::ParseRegime(FLAGS_sim_regime), FLAGS_sim_index,
@@ -107,10 +119,13 @@ std::unique_ptr<io::DataSource> OpenSource() {
                                                   ? ": neither a dataset folder nor a ROS 1 bag"
                                                   : ": dataset folder or bag does not exist"));
   }
-  if (FLAGS_format.empty()) return io::OpenDataset(FLAGS_dataset);
-  if (FLAGS_format == "newer_college")
-    return std::make_unique<io::NewerCollegeReader>(FLAGS_dataset);
-  if (FLAGS_format == "ctlio") return std::make_unique<io::SimFolderReader>(FLAGS_dataset);
+  if (FLAGS_format.empty()) return io::OpenDataset(FLAGS_dataset, gap_ns);
+  if (FLAGS_format == "newer_college") {
+    io::NewerCollegeOptions options;
+    options.max_imu_gap_error_ns = gap_ns;
+    return std::make_unique<io::NewerCollegeReader>(FLAGS_dataset, options);
+  }
+  if (FLAGS_format == "ctlio") return std::make_unique<io::SimFolderReader>(FLAGS_dataset, gap_ns);
   if (FLAGS_format == "kitti") return std::make_unique<io::KittiReader>(FLAGS_dataset);
   throw std::runtime_error("unknown --format '" + FLAGS_format +
                            "' (newer_college, ctlio, kitti, rosbag, sim)");
@@ -155,22 +170,35 @@ int main(int argc, char** argv) {
     const std::vector<std::string> methods = Split(FLAGS_method);
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
-    if (!FLAGS_config.empty()) base = lio::LoadOdometryConfig(FLAGS_config);
+    lio::InputCheckOptions checks;
     // An `extrinsic:` written in the config wins over the dataset's (precedence in README).
-    const bool config_extrinsic =
-        !FLAGS_config.empty() && YAML::LoadFile(FLAGS_config)["extrinsic"].IsDefined();
+    bool config_extrinsic = false;
+    if (!FLAGS_config.empty()) {
+      // The `input:` section belongs to the run (readers and input gates), the rest to the
+      // odometry.
+      YAML::Node root = lio::LoadYamlFile(FLAGS_config, "odometry config");
+      config_extrinsic = root["extrinsic"].IsDefined();
+      checks = lio::TakeInputCheckOptions(&root, FLAGS_config);
+      base = lio::OdometryConfigFromYaml(root, FLAGS_config);
+    }
+    if (!gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default) {
+      checks.max_imu_gap_error = FLAGS_max_imu_gap_error;
+    }
+    checks.Validate();
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
+    if (FLAGS_max_scans < 0) throw std::runtime_error("--max_scans must be >= 0 (0 = all)");
     std::vector<lioapp::RunSummary> runs;
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
     for (const std::string& m : methods) {
       lio::OdometryConfig config = base;
       config.method = lio::ParseLioMethod(m);
-      auto source = OpenSource();
+      auto source = OpenSource(checks.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
       lioapp::RunOptions options;
-      options.max_scans = static_cast<size_t>(std::max(0, FLAGS_max_scans));
+      options.max_scans = static_cast<size_t>(FLAGS_max_scans);
+      options.checks = checks;
       options.extrinsic_from_config = config_extrinsic;
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       if (FLAGS_progress) {
@@ -189,7 +217,8 @@ int main(int argc, char** argv) {
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       if (!run.dense.empty()) io::WriteTum(out + "/trajectory_dense.tum", run.dense);
       lioapp::WriteScanLog(out + "/scans.log", run);
-      std::ofstream ev(out + "/evaluation.txt");
+      const std::string ev_path = out + "/evaluation.txt";
+      std::ofstream ev = io::OpenForWriting(ev_path);
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
          << "\nfailed_scans " << run.failed << "\ndegenerate_scans " << run.degenerate
          << "\nimu_gap_scans " << run.imu_gaps << "\nmedian_ms " << run.median_ms << "\np95_ms "
@@ -198,7 +227,13 @@ int main(int argc, char** argv) {
          << run.median_preprocess_ms << "\nmedian_associate_ms " << run.median_associate_ms
          << "\nmedian_solve_ms " << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
          << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
-         << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin << "\"\n";
+         << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin
+         << "\"\nimu_samples_rejected " << run.imu_rejected
+         << "\npoints_dropped_out_of_interval " << run.points_dropped << "\nscans_skipped "
+         << run.scans_skipped << "\nconstant_imu_scans " << run.constant_imu_scans << "\n";
+      if (!run.first_input_warning.empty()) {
+        ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
+      }
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
@@ -222,6 +257,7 @@ int main(int argc, char** argv) {
       if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
       folders.push_back(out);
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
+      io::CloseChecked(ev, ev_path);
       runs.push_back(std::move(run));
     }
     if (FLAGS_plot && !PlotWithMatplotlib(FLAGS_out, folders)) {
@@ -246,6 +282,13 @@ int main(int argc, char** argv) {
       }
       std::printf(" %6d %6d %9.1f %9.1f %9.1f %9.1f %9.1f\n", r.failed, r.degenerate, r.median_ms,
                   r.p95_ms, r.median_cpu_ms, r.p95_cpu_ms, r.peak_rss_kb / 1024.0);
+      if (r.imu_rejected + r.points_dropped + r.scans_skipped + r.constant_imu_scans > 0) {
+        std::printf(
+            "  %-10s input: %d IMU samples rejected, %d points dropped, %d scans skipped, %d scans "
+            "with a frozen IMU (first: %s)\n",
+            r.method.c_str(), r.imu_rejected, r.points_dropped, r.scans_skipped,
+            r.constant_imu_scans, r.first_input_warning.c_str());
+      }
       std::printf(
           "  %-10s wall-time split, median ms: preprocess %.1f  associate %.1f  solve %.1f"
           "  map %.1f  marginalise %.1f\n",

@@ -61,7 +61,8 @@ DEFINE_double(bias_walk_gyro, 0.0, "Gyro bias random walk [rad/s/√s]");
 DEFINE_int32(pillars, 0, "Interior 1 m × 1 m pillars placed at random (seeded) in the room");
 DEFINE_bool(ground_truth, true, "Write the ground-truth trajectory");
 DEFINE_bool(newer_college_extrinsic, false,
-            "Use the Newer College lidar→IMU extrinsic instead of identity");
+            "Use the Newer College lidar→IMU extrinsic instead of identity (always used with "
+            "--layout=newer_college, which cannot carry another)");
 
 namespace {
 
@@ -99,6 +100,13 @@ int main(int argc, char** argv) {
   try {
     using namespace ctlio;
     const sim::Regime regime = sim::ParseRegime(FLAGS_regime);
+    // inf wrote 0 scans with exit 0, nan failed in vector::reserve.
+    if (!(FLAGS_duration > 0.0 && FLAGS_duration <= 3600.0)) {
+      throw std::runtime_error("--duration must be in (0, 3600] s");
+    }
+    if (FLAGS_firing_decimation < 1 || FLAGS_beams < 1) {
+      throw std::runtime_error("--firing_decimation and --beams must be >= 1");
+    }
     const sim::WorldKind world = sim::ParseWorld(FLAGS_world);
     if (FLAGS_pillars > 0 && world != sim::WorldKind::kBox) {
       throw std::runtime_error("--pillars is a box-world option");
@@ -127,7 +135,10 @@ int main(int argc, char** argv) {
     config.imu.body_centric = FLAGS_body_centric;
     config.imu.accel_bias_walk = FLAGS_bias_walk_accel;
     config.imu.gyro_bias_walk = FLAGS_bias_walk_gyro;
-    if (FLAGS_newer_college_extrinsic) config.imu_from_lidar = io::NewerCollegeImuFromLidar();
+    // The Newer College layout carries no extrinsic and is read with the published one.
+    if (FLAGS_newer_college_extrinsic || FLAGS_layout == "newer_college") {
+      config.imu_from_lidar = io::NewerCollegeImuFromLidar();
+    }
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
     if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
     std::mt19937_64 rng(FLAGS_seed + 17);

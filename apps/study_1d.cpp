@@ -15,6 +15,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/study/study.h"
 
 DEFINE_double(duration, 10.0, "trajectory length (s)");
@@ -209,7 +210,7 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     json << "},\n\"seconds_main_study\": " << main_seconds << ", \"seconds_total\": " << total
          << "}\n";
-    std::ofstream(FLAGS_output_dir + "/summary.json") << json.str();
+    ctlio::io::WriteTextFile(FLAGS_output_dir + "/summary.json", json.str());
     std::printf("main study (training + %d test trajectories per dataset): %.1f s; total %.1f s\n",
                 FLAGS_test, main_seconds, total);
     std::printf("wrote %s/summary.json and per-time CSVs\n", FLAGS_output_dir.c_str());

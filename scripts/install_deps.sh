@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs ctlio's build and test dependencies from Debian 12 packages.
+# Installs ctlio's build and test dependencies from Debian 12 packages (clang and its runtime
+# libclang-rt-14-dev build the libFuzzer targets of scripts/fuzz.sh).
 # Safe to re-run: when everything is present it only checks and returns.
 set -euo pipefail
 
@@ -9,6 +10,7 @@ packages=(
   libgflags-dev libgoogle-glog-dev libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev python3-matplotlib python3-numpy
   librosbag-dev libsensor-msgs-dev libtf2-msgs-dev libnav-msgs-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

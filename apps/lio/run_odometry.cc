@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 
 namespace ctlio::lioapp {
@@ -107,7 +108,23 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
               << r.angle() * 180.0 / M_PI << " deg about [" << r.axis().transpose() << "]";
   }
   if (const auto g = source.Gravity()) config.gravity = *g;
+  lio::ValidateIterationLimits(config);
+  const lio::InputCheckOptions& checks = options.checks;
+  checks.Validate();
   auto odometry = lio::MakeLioOdometry(config);
+  auto warn = [&](const std::string& m) {
+    LOG(WARNING) << source.Name() << ": " << m;
+    if (run.first_input_warning.empty()) run.first_input_warning = m;
+  };
+  const bool uses_imu = config.method != lio::LioMethod::kLidarOnly;
+  const bool uses_accel =
+      config.method == lio::LioMethod::kSingerLio || config.method == lio::LioMethod::kImuInput;
+  lio::ConstantImuDetector constant_imu;
+  std::vector<lio::ImuSample> gravity_samples;
+  bool gravity_checked = !uses_accel;
+  bool have_previous = false;
+  int64_t previous_end = 0;
+  SE3 previous_pose;
   run.method = lio::LioMethodName(config.method);
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
@@ -119,14 +136,64 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
-    for (const io::ImuSample& s : frame.imu) odometry->AddImu(s);
+    for (const io::ImuSample& x : frame.imu) {
+      if (const auto why = lio::CheckImuRange(x, checks)) {
+        if (++run.imu_rejected <= 5) {
+          warn("IMU sample at " + io::FormatSecondsNs(x.t_ns) + " s rejected: " + *why);
+        }
+        continue;
+      }
+      constant_imu.Add(x);
+      if (!gravity_checked) {
+        gravity_samples.push_back(x);
+        if (1e-9 * double(x.t_ns - gravity_samples.front().t_ns) >= config.gravity_init_duration) {
+          gravity_checked = true;
+          if (const auto m = lio::CheckGravityMagnitude(gravity_samples, config.gravity,
+                                                        checks.gravity_tolerance)) {
+            throw std::runtime_error(source.Name() + ": " + *m);
+          }
+        }
+      }
+      odometry->AddImu(x);
+    }
+    if (have_previous && frame.end_ns <= previous_end) {
+      ++run.scans_skipped;
+      warn("scan " + std::to_string(frame.index) + " skipped: its end " +
+           io::FormatSecondsNs(frame.end_ns) + " s is not after the previous scan's " +
+           io::FormatSecondsNs(previous_end) + " s");
+      continue;
+    }
     lio::LidarScan scan;
     scan.begin_ns = frame.start_ns;
     scan.end_ns = frame.end_ns;
     scan.points = std::move(frame.cloud.points);
     scan.times_ns = std::move(frame.cloud.times_ns);
     if (scan.times_ns.empty()) scan.times_ns.assign(scan.points.size(), scan.end_ns);
-    const lio::ScanResult r = odometry->AddScan(scan);
+    if (have_previous) {
+      const size_t dropped = lio::DropPointsBefore(
+          previous_end, std::llround(checks.scan_time_tolerance * 1e9), &scan);
+      if (dropped > 0) {
+        run.points_dropped += int(dropped);
+        warn("scan " + std::to_string(frame.index) + ": dropped " + std::to_string(dropped) +
+             " points timed before the previous scan's end (input.scan_time_tolerance)");
+      }
+    }
+    lio::ScanResult r = odometry->AddScan(scan);
+    bool suspect = false;
+    if (uses_imu && r.status != lio::ScanStatus::kFailed && have_previous &&
+        constant_imu.ConstantSeconds() >= checks.constant_imu_duration &&
+        lio::PoseMoved(previous_pose, r.T_mr, checks)) {
+      suspect = true;
+      ++run.constant_imu_scans;
+      const std::string m = "IMU output constant for " +
+                            std::to_string(constant_imu.ConstantSeconds()) +
+                            " s while the lidar moves (frozen or dead IMU)";
+      warn("scan " + std::to_string(frame.index) + ": " + m);
+      r.message += (r.message.empty() ? "" : "; ") + m;
+    }
+    have_previous = true;
+    previous_end = frame.end_ns;
+    if (r.status != lio::ScanStatus::kFailed) previous_pose = r.T_mr;
     ++done;
     ms.push_back(r.milliseconds);
     switch (r.status) {
@@ -154,6 +221,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       }
     }
     run.scans.push_back(r);
+    run.suspect.push_back(suspect);
     if (options.progress) options.progress(done, total, r);
   }
   // The first scan (map creation) is not a registration: keep it out of the latency figures.
@@ -182,10 +250,12 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   }
   run.peak_rss_kb = PeakRssKb();
   if (const auto truth = source.GroundTruth()) {
-    run.ate = EvaluateAte(run.trajectory, *truth);
+    // No ATE where there is no estimate to evaluate (e.g. every scan failed initialisation).
+    const AteResult ate = EvaluateAte(run.trajectory, *truth);
+    if (ate.pairs >= 3) run.ate = ate;
   }
-  run.failure =
-      run.failed > 0 || (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
+  run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
+                (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
   return run;
 }
 
@@ -238,8 +308,7 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
     s << "'/>\n";
     return s.str();
   };
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write the plot");
+  std::ofstream f = io::OpenForWriting(path);
   f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << left + size + 30 << "' height='"
     << top + size + 60 << "' font-family='sans-serif'>\n<rect width='100%' height='100%' "
     << "fill='white'/>\n";
@@ -263,23 +332,26 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
     << "' y='" << top + 18 << "' font-size='12' fill='#888888'>ground truth</text>\n<text x='"
     << left + 10 << "' y='" << top + 34
     << "' font-size='12' fill='#d62728'>estimate (scan poses, aligned)</text>\n</svg>\n";
+  io::CloseChecked(f, path);
 }
 
 void WriteScanLog(const std::string& path, const RunSummary& run) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write the scan log");
+  std::ofstream f = io::OpenForWriting(path);
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
        "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z message\n";
   f << std::setprecision(12);
-  for (const lio::ScanResult& r : run.scans) {
+  for (size_t i = 0; i < run.scans.size(); ++i) {
+    const lio::ScanResult& r = run.scans[i];
+    const bool suspect = i < run.suspect.size() && run.suspect[i];
     const Vec3 p = r.T_mr.translation();
-    f << 1e-9 * double(r.t_ns) << ' ' << lio::ScanStatusName(r.status) << ' ' << r.keypoints << ' '
-      << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds << ' ' << r.solver_iterations
-      << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << r.ms_preprocess << ' '
-      << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << r.ms_marginalize << ' '
-      << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
+    f << 1e-9 * double(r.t_ns) << ' ' << (suspect ? "suspect" : lio::ScanStatusName(r.status))
+      << ' ' << r.keypoints << ' ' << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds
+      << ' ' << r.solver_iterations << ' ' << r.final_cost << ' ' << r.milliseconds << ' '
+      << r.ms_preprocess << ' ' << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' '
+      << r.ms_marginalize << ' ' << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
       << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
+  io::CloseChecked(f, path);
 }
 
 }  // namespace ctlio::lioapp
@@ -288,8 +360,7 @@ namespace ctlio::lioapp {
 
 void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write the pose errors");
+  std::ofstream f = io::OpenForWriting(path);
   f << "t_s,est_x,est_y,est_z,ref_x,ref_y,ref_z,position_error_m,rotation_error_deg\n";
   f << std::setprecision(12);
   const Mat3 A = alignment.topLeftCorner<3, 3>();
@@ -314,6 +385,7 @@ void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>
       << ',' << p.y() << ',' << p.z() << ',' << (q - p).norm() << ',' << angle * 180.0 / M_PI
       << '\n';
   }
+  io::CloseChecked(f, path);
 }
 
 }  // namespace ctlio::lioapp

@@ -180,10 +180,19 @@ TEST(BadInput, PcdWithoutTimeField) {
       << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << c.size() << "\nDATA ascii\n";
   for (const auto& p : c.points) out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
   out.close();
+  ExpectError(
+      [&] {
+        ReadPcd(scan.string(), {0, true});
+      },
+      {"cloud_1583836591_282590000.pcd", "line 2", "time field"});
+  // In a sequence the scan is unusable, not fatal: handed on empty over its interval (logged).
   NewerCollegeReader r(d.string());
   ScanFrame f;
   ASSERT_TRUE(r.Next(&f));
-  ExpectError([&] { r.Next(&f); }, {"cloud_1583836591_282590000.pcd", "line 2", "time field"});
+  ASSERT_TRUE(r.Next(&f));
+  EXPECT_EQ(f.cloud.size(), 0u);
+  EXPECT_GT(f.end_ns, f.start_ns);
+  EXPECT_TRUE(r.Next(&f));
 }
 
 TEST(BadInput, ScansOutOfOrder) {
@@ -232,10 +241,12 @@ TEST(BadInput, ImuBackwardsDuplicatedAndGaps) {
     in.close();
     std::ofstream(imu) << out.str();
   }
-  ExpectError([&] { NewerCollegeReader r(d.string()); }, {"data.csv:10", "gap of 0.15"});
-  NewerCollegeOptions lax;
-  lax.max_imu_gap_ns = 0;
-  EXPECT_NO_THROW(NewerCollegeReader(d.string(), lax));
+  // By default a gap is a warning and every sample is handed on; the limit is an opt-in error.
+  EXPECT_EQ(NewerCollegeReader(d.string()).imu().size(), before - 30);
+  NewerCollegeOptions strict;
+  strict.max_imu_gap_error_ns = 100'000'000;
+  ExpectError([&] { NewerCollegeReader r(d.string(), strict); }, {"data.csv:10", "gap of 0.15"});
+  ExpectError([&] { OpenDataset(d.string(), 100'000'000); }, {"data.csv:10", "gap of 0.15"});
 }
 
 TEST(Kitti, RealSampleScansAndGroundTruth) {

@@ -2,7 +2,9 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -19,8 +21,31 @@ void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cur
   while (*cursor < imu.size() && imu[*cursor].t_ns <= end_ns) out->push_back(imu[(*cursor)++]);
 }
 
-void CheckImuStream(const std::string& path, const std::vector<int>& lines, int64_t max_gap_ns,
-                    std::vector<ImuSample>* imu) {
+size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c) {
+  if (!c->has_times()) return 0;
+  size_t kept = 0;
+  const size_t n = c->size();
+  for (size_t i = 0; i < n; ++i) {
+    if (c->times_ns[i] < lo_ns || c->times_ns[i] > hi_ns) continue;
+    c->points[kept] = c->points[i];
+    c->times_ns[kept] = c->times_ns[i];
+    if (c->intensity.size() == n) c->intensity[kept] = c->intensity[i];
+    if (c->ring.size() == n) c->ring[kept] = c->ring[i];
+    ++kept;
+  }
+  if (kept == n) return 0;
+  LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
+               << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
+               << ", " << FormatSecondsNs(hi_ns) << "] s";
+  c->points.resize(kept);
+  c->times_ns.resize(kept);
+  if (c->intensity.size() == n) c->intensity.resize(kept);
+  if (c->ring.size() == n) c->ring.resize(kept);
+  return n - kept;
+}
+
+void CheckImuStream(const std::string& path, const std::vector<int>& lines,
+                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu) {
   std::vector<ImuSample> kept;
   kept.reserve(imu->size());
   size_t duplicates = 0;
@@ -40,10 +65,10 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines, int6
                "IMU time goes backwards (" + std::to_string(s.t_ns) + " ns after " +
                    std::to_string(prev) + " ns)");
       }
-      if (max_gap_ns > 0 && s.t_ns - prev > max_gap_ns) {
+      if (max_gap_error_ns > 0 && s.t_ns - prev > max_gap_error_ns) {
         FailAt(path, line,
                "gap of " + std::to_string(1e-9 * double(s.t_ns - prev)) + " s in the IMU (limit " +
-                   std::to_string(1e-9 * double(max_gap_ns)) + " s)");
+                   std::to_string(1e-9 * double(max_gap_error_ns)) + " s, --max_imu_gap_error)");
       }
     }
     kept.push_back(s);
@@ -52,6 +77,24 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines, int6
     LOG(WARNING) << path << ": dropped " << duplicates << " duplicate IMU sample(s)";
   }
   *imu = std::move(kept);
+  // Gaps are reported, not fatal by default: the odometry bridges them with its motion prior.
+  // A gap is a spacing above 3× the median spacing.
+  std::vector<int64_t> dt;
+  for (size_t i = 1; i < imu->size(); ++i) dt.push_back((*imu)[i].t_ns - (*imu)[i - 1].t_ns);
+  if (dt.size() < 2) return;
+  std::vector<int64_t> sorted = dt;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const int64_t median = sorted[sorted.size() / 2];
+  size_t gaps = 0;
+  for (size_t i = 0; i < dt.size(); ++i) {
+    if (dt[i] <= 3 * median) continue;
+    if (++gaps <= 10) {
+      LOG(WARNING) << path << ":" << (i + 1 < lines.size() ? lines[i + 1] : 0) << ": gap of "
+                   << 1e-9 * double(dt[i]) << " s in the IMU (median spacing "
+                   << 1e-9 * double(median) << " s); samples handed on";
+    }
+  }
+  if (gaps > 10) LOG(WARNING) << path << ": " << gaps << " IMU gaps in all";
 }
 
 bool ParseSecondsNs(const std::string& s, int64_t* ns) {
@@ -65,7 +108,7 @@ bool ParseSecondsNs(const std::string& s, int64_t* ns) {
   int64_t sec = 0, frac = 0;
   int digits = 0, frac_digits = 0;
   for (; i < s.size() && std::isdigit(static_cast<unsigned char>(s[i])); ++i, ++digits) {
-    if (sec > (INT64_MAX / 10 - 10) / 1000000000) return false;
+    if (sec > INT64_MAX / 10000000000) return false;  // sec · 10⁹ would overflow anyway
     sec = sec * 10 + (s[i] - '0');
   }
   if (i < s.size() && s[i] == '.') {
@@ -77,13 +120,27 @@ bool ParseSecondsNs(const std::string& s, int64_t* ns) {
     // Not plain decimal (e.g. 1.5e9): accept through double as a last resort.
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
-    if (end != s.c_str() + s.size() || !std::isfinite(v)) return false;
-    *ns = std::llround(v * 1e9);
-    return true;
+    if (end != s.c_str() + s.size()) return false;
+    return SecondsToNs(v, ns);
   }
   for (int k = frac_digits; k < 9; ++k) frac *= 10;
-  *ns = (neg ? -1 : 1) * (sec * 1000000000 + frac);
+  int64_t v = 0;
+  if (!SecNsecToNs(sec, frac, &v)) return false;
+  *ns = neg ? -v : v;
   return true;
+}
+
+bool SecondsToNs(double s, int64_t* ns) {
+  if (!(std::abs(s) < 9.2e9)) return false;  // also rejects NaN
+  *ns = std::llround(s * 1e9);
+  return true;
+}
+
+bool SecNsecToNs(int64_t sec, int64_t nsec, int64_t* ns) {
+  if (nsec < 0 || nsec >= 1000000000) return false;
+  int64_t s = 0;
+  return !__builtin_mul_overflow(sec, int64_t(1000000000), &s) &&
+         !__builtin_add_overflow(s, nsec, ns);
 }
 
 std::string FormatSecondsNs(int64_t ns) {
@@ -95,15 +152,17 @@ std::string FormatSecondsNs(int64_t ns) {
   return buf;
 }
 
-std::unique_ptr<DataSource> OpenDataset(const std::string& folder) {
+std::unique_ptr<DataSource> OpenDataset(const std::string& folder, int64_t max_imu_gap_error_ns) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) throw std::runtime_error(folder + ": folder not found");
   if (fs::exists(fs::path(folder) / "ctlio_sim.yaml")) {
-    return std::make_unique<SimFolderReader>(folder);
+    return std::make_unique<SimFolderReader>(folder, max_imu_gap_error_ns);
   }
   if (fs::is_directory(fs::path(folder) / "raw_format")) {
-    return std::make_unique<NewerCollegeReader>(folder);
+    NewerCollegeOptions options;
+    options.max_imu_gap_error_ns = max_imu_gap_error_ns;
+    return std::make_unique<NewerCollegeReader>(folder, options);
   }
   if (fs::is_directory(fs::path(folder) / "velodyne")) return std::make_unique<KittiReader>(folder);
   throw std::runtime_error(folder +

@@ -105,11 +105,18 @@ KittiReader::KittiReader(const std::string& folder) : folder_(folder) {
 bool KittiReader::Next(ScanFrame* frame) {
   if (next_ >= scans_.size()) return false;
   const int64_t stamp = times_[next_];
+  constexpr int64_t kPeriod = 100'000'000;  // HDL-64E at 10 Hz
   frame->index = next_;
-  if (!point_times_[next_].empty()) {
-    frame->cloud = ReadKittiBin(scans_[next_], floats_per_point_, point_times_[next_], stamp);
-  } else {
-    frame->cloud = ReadKittiBin(scans_[next_], floats_per_point_, "", stamp);
+  const std::string& path = scans_[next_];
+  try {
+    frame->cloud = ReadKittiBin(path, floats_per_point_, point_times_[next_], stamp);
+  } catch (const UnusableCloudError& e) {
+    LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    frame->cloud = PointCloud();
+    frame->cloud.stamp_ns = stamp;
+  }
+  auto& c = frame->cloud;
+  if (point_times_[next_].empty()) {
     static bool logged = false;
     if (!logged) {
       LOG(INFO) << folder_ << ": no per-point times, filled from the azimuth (see kitti.h)";
@@ -117,18 +124,25 @@ bool KittiReader::Next(ScanFrame* frame) {
     }
     // KITTI stamps a sweep when the scanner faces forward (azimuth 0): the sweep begins half a
     // revolution earlier, facing backwards.
-    auto& c = frame->cloud;
-    constexpr int64_t kPeriodNs = 100'000'000;
     c.times_ns.resize(c.size());
     for (size_t i = 0; i < c.size(); ++i) {
-      c.times_ns[i] = stamp - kPeriodNs / 2 + AzimuthOffsetNs(c.points[i], M_PI, kPeriodNs);
+      c.times_ns[i] = stamp - kPeriod / 2 + AzimuthOffsetNs(c.points[i], M_PI, kPeriod);
     }
-    c.stamp_ns = *std::min_element(c.times_ns.begin(), c.times_ns.end());
   }
-  frame->start_ns = frame->cloud.stamp_ns;
-  frame->end_ns = frame->cloud.has_times() ? *std::max_element(frame->cloud.times_ns.begin(),
-                                                               frame->cloud.times_ns.end())
-                                           : stamp;
+  frame->start_ns = c.times_ns.empty()
+                        ? stamp
+                        : std::min(stamp, *std::min_element(c.times_ns.begin(), c.times_ns.end()));
+  c.stamp_ns = frame->start_ns;
+  frame->end_ns = c.times_ns.empty() ? frame->start_ns
+                                     : *std::max_element(c.times_ns.begin(), c.times_ns.end());
+  if (frame->end_ns <= frame->start_ns) {
+    // Recovery shared with the other layouts: without usable points (empty, all non-finite) or
+    // with all points at one time the scan gets its nominal interval, up to the next stamp.
+    LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
+                 << " non-finite), all at one time; scan interval set to its nominal 0.1 s";
+    const int64_t next_stamp = next_ + 1 < times_.size() ? times_[next_ + 1] : stamp + kPeriod;
+    frame->end_ns = std::max(frame->start_ns + 1, std::min(stamp + kPeriod, next_stamp - 1));
+  }
   frame->imu.clear();
   ++next_;
   return true;

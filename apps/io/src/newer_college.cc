@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/text_table.h"
 
 namespace ctlio::io {
@@ -39,10 +40,11 @@ SE3 PoseFromRow(const std::string& path, const TableRow& row, size_t first) {
 
 int64_t StampFromSecNsec(const std::string& path, const TableRow& row, size_t k) {
   const int64_t sec = ToInt64(path, row, k), nsec = ToInt64(path, row, k + 1);
-  if (sec < 0 || nsec < 0 || nsec >= 1000000000) {
-    FailAt(path, row.line, "sec/nsec out of range");
+  int64_t ns = 0;
+  if (sec < 0 || !SecNsecToNs(sec, nsec, &ns)) {
+    FailAt(path, row.line, "sec/nsec out of range (0 <= sec, 0 <= nsec < 1e9, int64 ns)");
   }
-  return sec * 1000000000 + nsec;
+  return ns;
 }
 }  // namespace
 
@@ -58,12 +60,13 @@ bool ParseNewerCollegeScanName(const std::string& name, int64_t* stamp_ns) {
   const size_t a = base.rfind('_', b - 1);
   if (a == std::string::npos) return false;
   const std::string sec = base.substr(a + 1, b - a - 1), nsec = base.substr(b + 1);
-  if (sec.empty() || nsec.empty() || nsec.size() > 9) return false;
+  // The nanoseconds are zero-padded to 9 digits (ROS stamps): "cloud_0_5.pcd" is not 5 ns.
+  if (sec.empty() || sec.size() > 10 || nsec.size() != 9) return false;
   for (char c : sec + nsec) {
     if (!std::isdigit(static_cast<unsigned char>(c))) return false;
   }
-  *stamp_ns = std::stoll(sec) * 1000000000 + std::stoll(nsec);
-  return true;
+  return SecNsecToNs(std::strtoll(sec.c_str(), nullptr, 10),
+                     std::strtoll(nsec.c_str(), nullptr, 10), stamp_ns);
 }
 
 NewerCollegeReader::NewerCollegeReader(const std::string& folder,
@@ -78,17 +81,23 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
     int64_t stamp = 0;
     if (!ParseNewerCollegeScanName(name, &stamp)) {
       throw std::runtime_error(e.path().string() +
-                               ": scan file name is not <name>_<sec>_<nsec>.pcd");
+                               ": scan file name is not <name>_<sec>_<nsec>.pcd (nsec: 9 digits)");
     }
     scans_.emplace_back(stamp, e.path().string());
   }
   if (scans_.empty()) throw std::runtime_error(ScanDir(seq).string() + ": no .pcd scans");
   // Recovery: order by stamp (directory listings are unordered); equal stamps are an error.
   std::sort(scans_.begin(), scans_.end());
+  std::vector<int64_t> spacing;
   for (size_t i = 1; i < scans_.size(); ++i) {
     if (scans_[i].first == scans_[i - 1].first) {
       throw std::runtime_error(scans_[i].second + ": same stamp as " + scans_[i - 1].second);
     }
+    spacing.push_back(scans_[i].first - scans_[i - 1].first);
+  }
+  if (!spacing.empty()) {
+    std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+    nominal_period_ns_ = spacing[spacing.size() / 2];
   }
 
   const std::string imu_path = ImuFile(seq).string();
@@ -105,7 +114,7 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
     lines.push_back(row.line);
   }
   if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
-  CheckImuStream(imu_path, lines, options_.max_imu_gap_ns, &imu_);
+  CheckImuStream(imu_path, lines, options_.max_imu_gap_error_ns, &imu_);
 
   const std::string gt_path = GtFile(seq).string();
   std::error_code ec;
@@ -127,16 +136,38 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
 bool NewerCollegeReader::Next(ScanFrame* frame) {
   if (next_ >= scans_.size()) return false;
   const auto& [stamp, path] = scans_[next_];
+  // The scan's interval: from its stamp to the next scan's stamp (the last scan: one nominal
+  // period, the median stamp spacing), with a tolerance for driver jitter.
+  const int64_t next_stamp =
+      next_ + 1 < scans_.size() ? scans_[next_ + 1].first : stamp + nominal_period_ns_;
+  const int64_t tolerance = std::max<int64_t>(nominal_period_ns_ / 10, 1);
   ReadOptions ro;
   ro.stamp_ns = stamp;
   ro.require_time = true;
   frame->index = next_;
-  frame->cloud = ReadPcd(path, ro);
+  try {
+    frame->cloud = ReadPcd(path, ro);
+  } catch (const UnusableCloudError& e) {
+    LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    frame->cloud = PointCloud();
+    frame->cloud.stamp_ns = stamp;
+  }
+  PointCloud& c = frame->cloud;
+  // Recovery: points whose time lies outside [stamp − tolerance, next stamp + tolerance] cannot be
+  // placed on the trajectory between this scan and its neighbours; they are dropped, with a word.
+  DropPointsOutside(path, stamp - tolerance, next_stamp + tolerance, &c);
   frame->start_ns = stamp;
   frame->end_ns = stamp;
-  for (int64_t t : frame->cloud.times_ns) frame->end_ns = std::max(frame->end_ns, t);
-  if (next_ + 1 < scans_.size() && frame->end_ns >= scans_[next_ + 1].first + 100'000'000) {
-    throw std::runtime_error(path + ": point times reach past the next scan's stamp by > 0.1 s");
+  for (int64_t t : c.times_ns) frame->end_ns = std::max(frame->end_ns, t);
+  if (frame->end_ns <= stamp) {
+    // Recovery (the ctlio layout's scans carry their interval in scans.csv): without usable points
+    // (empty, all non-finite) or with all points at the stamp the file gives no interval; the
+    // scan gets its nominal one, up to the next stamp. An empty scan is reported degenerate by the
+    // odometry.
+    LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
+                 << " non-finite), none after the stamp; scan interval set to ["
+                 << FormatSecondsNs(stamp) << ", " << FormatSecondsNs(next_stamp) << ") s";
+    frame->end_ns = std::max(stamp + 1, next_stamp - 1);
   }
   frame->imu.clear();
   TakeImuUntil(imu_, frame->end_ns, &imu_cursor_, &frame->imu);
@@ -152,11 +183,19 @@ std::optional<std::vector<StampedPose>> NewerCollegeReader::GroundTruth() const 
 size_t WriteNewerCollege(DataSource& source, const std::string& folder,
                          const std::function<void(size_t, size_t)>& progress,
                          bool write_ground_truth) {
+  // The layout has no place for the extrinsic and the reader assumes the published one: a folder
+  // written with another would be read wrongly without a word, so it is refused.
+  const SE3 T = source.ImuFromLidar(), published = NewerCollegeImuFromLidar();
+  if ((T.Matrix() - published.Matrix()).cwiseAbs().maxCoeff() > 1e-9) {
+    throw std::runtime_error(folder +
+                             ": the Newer College layout carries no extrinsic and is read with the "
+                             "published T_imu_lidar; this source has another one (use the ctlio "
+                             "layout, or the published extrinsic)");
+  }
   const fs::path seq(folder);
   fs::create_directories(ScanDir(seq));
   fs::create_directories(ImuFile(seq).parent_path());
-  std::ofstream imu(ImuFile(seq));
-  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": cannot open for writing");
+  std::ofstream imu = OpenForWriting(ImuFile(seq).string());
   imu << "counter,sec,nsec,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
   size_t counter = 0, n = 0;
   ScanFrame frame;
@@ -175,11 +214,10 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
     ++n;
     if (progress) progress(n, source.NumScans());
   }
-  if (!imu) throw std::runtime_error(ImuFile(seq).string() + ": write failed");
+  CloseChecked(imu, ImuFile(seq).string());
   if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
     fs::create_directories(GtFile(seq).parent_path());
-    std::ofstream out(GtFile(seq));
-    if (!out) throw std::runtime_error(GtFile(seq).string() + ": cannot open for writing");
+    std::ofstream out = OpenForWriting(GtFile(seq).string());
     out << "#sec,nsec,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
     for (const auto& p : *gt) {
       const Eigen::Quaterniond q = p.pose.quaternion();
@@ -187,6 +225,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
       out << p.t_ns / 1000000000 << ',' << p.t_ns % 1000000000 << ',' << r.x() << ',' << r.y()
           << ',' << r.z() << ',' << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w() << '\n';
     }
+    CloseChecked(out, GtFile(seq).string());
   }
   return n;
 }

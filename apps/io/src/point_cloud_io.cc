@@ -12,7 +12,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
+#include "ctlio/io/dataset.h"
 #include "ctlio/io/point_fields.h"
+#include "raw_cloud.h"
 
 namespace ctlio::io {
 namespace {
@@ -26,179 +29,63 @@ void RequireFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, ec)) Fail(path, "file not found");
 }
 
-// Validates a PCD header line by line before PCL sees the file: PCL's reader reports no line
-// numbers and crashes on some malformed headers. Returns the 1-based line of FIELDS.
-int CheckPcdHeader(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Fail(path, "cannot open");
-  std::string line;
-  int fields_line = 0;
-  size_t n_fields = 0, width = 0, height = 0, points = 0, point_step = 0;
-  std::vector<size_t> sizes, counts;
-  bool have_width = false, have_height = false, have_size = false, have_type = false;
-  auto fail = [&](int n, const std::string& what) -> void {
-    Fail(path, "line " + std::to_string(n) + ": " + what);
-  };
-  auto numbers = [&](std::istringstream& ss, int n) {
-    std::vector<size_t> v;
-    std::string tok;
-    while (ss >> tok) {
-      try {
-        size_t used = 0;
-        const long long x = std::stoll(tok, &used);
-        if (used != tok.size() || x < 0) throw std::invalid_argument(tok);
-        v.push_back(size_t(x));
-      } catch (const std::exception&) {
-        fail(n, "'" + tok + "' is not a non-negative integer");
-      }
+// The raw field list in point_fields' terms (PointCloud2 datatype codes), so that PCD and PLY
+// detect per-point times exactly as ROS PointCloud2 messages do. 64-bit integer fields, which
+// PointCloud2 cannot express, get code 0: no time convention matches them.
+std::vector<PointField> LayoutFields(const detail::RawCloud& c) {
+  std::vector<PointField> out;
+  out.reserve(c.fields.size());
+  for (const detail::FieldDesc& f : c.fields) {
+    uint8_t code = 0;
+    switch (f.type) {
+      case detail::ScalarType::kInt8: code = kInt8; break;
+      case detail::ScalarType::kUint8: code = kUInt8; break;
+      case detail::ScalarType::kInt16: code = kInt16; break;
+      case detail::ScalarType::kUint16: code = kUInt16; break;
+      case detail::ScalarType::kInt32: code = kInt32; break;
+      case detail::ScalarType::kUint32: code = kUInt32; break;
+      case detail::ScalarType::kFloat32: code = kFloat32; break;
+      case detail::ScalarType::kFloat64: code = kFloat64; break;
+      default: break;
     }
-    return v;
-  };
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ss(line);
-    std::string key;
-    ss >> key;
-    if (key == "VERSION" || key == "VIEWPOINT") {
-      continue;
-    } else if (key == "FIELDS") {
-      fields_line = n;
-      std::string f;
-      while (ss >> f) ++n_fields;
-      if (n_fields == 0) fail(n, "FIELDS lists no field");
-    } else if (key == "SIZE") {
-      sizes = numbers(ss, n);
-      have_size = true;
-      for (size_t s : sizes) {
-        if (s != 1 && s != 2 && s != 4 && s != 8) fail(n, "SIZE must be 1, 2, 4 or 8");
-      }
-    } else if (key == "TYPE") {
-      std::string t;
-      size_t k = 0;
-      while (ss >> t) {
-        ++k;
-        if (t != "F" && t != "U" && t != "I") fail(n, "TYPE must be F, U or I, not '" + t + "'");
-      }
-      have_type = k > 0;
-    } else if (key == "COUNT") {
-      counts = numbers(ss, n);
-    } else if (key == "WIDTH") {
-      const auto v = numbers(ss, n);
-      if (v.size() != 1) fail(n, "WIDTH needs one value");
-      width = v[0];
-      have_width = true;
-    } else if (key == "HEIGHT") {
-      const auto v = numbers(ss, n);
-      if (v.size() != 1) fail(n, "HEIGHT needs one value");
-      height = v[0];
-      have_height = true;
-    } else if (key == "POINTS") {
-      const auto v = numbers(ss, n);
-      if (v.size() != 1) fail(n, "POINTS needs one value");
-      points = v[0];
-    } else if (key == "DATA") {
-      std::string kind;
-      ss >> kind;
-      if (kind != "ascii" && kind != "binary" && kind != "binary_compressed") {
-        fail(n, "DATA must be ascii, binary or binary_compressed, not '" + kind + "'");
-      }
-      if (!fields_line || !have_size || !have_type || !have_width) {
-        fail(n, "header lacks FIELDS, SIZE, TYPE or WIDTH before DATA");
-      }
-      if (sizes.size() != n_fields) fail(n, "SIZE and FIELDS differ in length");
-      if (!counts.empty() && counts.size() != n_fields)
-        fail(n, "COUNT and FIELDS differ in length");
-      if (!have_height) height = 1;
-      if (width * height != points && points != 0) {
-        fail(n, "WIDTH*HEIGHT (" + std::to_string(width * height) + ") differs from POINTS (" +
-                    std::to_string(points) + ")");
-      }
-      for (size_t i = 0; i < n_fields; ++i)
-        point_step += sizes[i] * (counts.empty() ? 1 : counts[i]);
-      if (kind == "binary") {
-        const std::streamoff header_end = in.tellg();
-        in.seekg(0, std::ios::end);
-        const std::streamoff bytes = in.tellg() - header_end;
-        if (bytes < std::streamoff(width * height * point_step)) {
-          fail(n, "binary data holds " + std::to_string(bytes) + " B, " +
-                      std::to_string(width * height * point_step) + " B expected");
-        }
-      }
-      return fields_line;
-    } else {
-      fail(n, "unknown PCD header key '" + key.substr(0, 32) + "'");
-    }
+    out.push_back({f.name, code, uint32_t(f.offset), uint32_t(f.count)});
   }
-  Fail(path, "no DATA line: not a PCD file");
+  return out;
 }
 
-const pcl::PCLPointField* FindField(const pcl::PCLPointCloud2& c, const std::string& name) {
-  for (const auto& f : c.fields) {
-    if (f.name == name) return &f;
+PointCloud FromRaw(const detail::RawCloud& c, const std::string& path, const ReadOptions& options) {
+  const std::string& where = c.fields_where;
+  const auto* fx = detail::FindField(c, "x");
+  const auto* fy = detail::FindField(c, "y");
+  const auto* fz = detail::FindField(c, "z");
+  if (!fx || !fy || !fz) Fail(path, where + "no x, y and z fields");
+  const std::vector<PointField> fields = LayoutFields(c);
+  PointLayout layout;
+  try {
+    layout = DetectPointLayout(fields, uint32_t(c.point_step),
+                               options.time ? *options.time : TimeFieldOptions{},
+                               path + ": " + where);
+  } catch (const std::exception& e) {
+    // A time field of a type no driver writes: the file is well formed but not a timed scan.
+    throw UnusableCloudError(e.what());
   }
-  return nullptr;
-}
-
-template <typename T>
-double Load(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));  // fields need not be aligned
-  return static_cast<double>(v);
-}
-
-// Reads a scalar field of any PCL numeric type as double.
-double ReadScalar(const uint8_t* p, uint8_t type) {
-  switch (type) {
-    case pcl::PCLPointField::INT8:
-      return Load<int8_t>(p);
-    case pcl::PCLPointField::UINT8:
-      return Load<uint8_t>(p);
-    case pcl::PCLPointField::INT16:
-      return Load<int16_t>(p);
-    case pcl::PCLPointField::UINT16:
-      return Load<uint16_t>(p);
-    case pcl::PCLPointField::INT32:
-      return Load<int32_t>(p);
-    case pcl::PCLPointField::UINT32:
-      return Load<uint32_t>(p);
-    case pcl::PCLPointField::FLOAT32:
-      return Load<float>(p);
-    case pcl::PCLPointField::FLOAT64:
-      return Load<double>(p);
-    default:
-      return std::numeric_limits<double>::quiet_NaN();
-  }
-}
-
-PointCloud FromCloud2(const pcl::PCLPointCloud2& c, const std::string& path,
-                      const ReadOptions& options, const std::string& fields_where) {
-  const auto* fx = FindField(c, "x");
-  const auto* fy = FindField(c, "y");
-  const auto* fz = FindField(c, "z");
-  if (!fx || !fy || !fz) Fail(path, fields_where + "no x, y and z fields");
-  // The per-point time convention: one detection for PCD and PointCloud2 (point_fields.h).
-  std::vector<PointField> fields;
-  for (const auto& f : c.fields) fields.push_back({f.name, f.datatype, f.offset, f.count});
-  const PointLayout layout = DetectPointLayout(
-      fields, 0, options.time ? *options.time : TimeFieldOptions{}, path + ": " + fields_where);
   if (options.require_time && !layout.time) {
-    Fail(path, fields_where + "no per-point time field (expected 't', 'offset_time', 'time' or " +
-                   "'timestamp'; fields found: " + DescribeFields(fields) + ")");
+    throw UnusableCloudError(path + ": " + where +
+                             "no per-point time field (expected 't', 'offset_time', 'time' or "
+                             "'timestamp'; fields found: " +
+                             DescribeFields(fields) + ")");
   }
-  const auto* fi = FindField(c, "intensity");
-  const auto* fr = FindField(c, "ring");
-  const size_t n = size_t(c.width) * c.height;
-  if (c.data.size() < n * c.point_step) Fail(path, "data section shorter than WIDTH*HEIGHT points");
+  const auto* fi = detail::FindField(c, "intensity");
+  const auto* fr = detail::FindField(c, "ring");
+  if (c.data.size() < c.points * c.point_step) Fail(path, "data section shorter than its points");
 
   PointCloud out;
   out.stamp_ns = options.stamp_ns;
-  out.points.reserve(n);
-  if (layout.time) out.times_ns.reserve(n);
-  for (size_t i = 0; i < n; ++i) {
-    const uint8_t* p = c.data.data() + i * c.point_step;
-    const Vec3 x(ReadScalar(p + fx->offset, fx->datatype), ReadScalar(p + fy->offset, fy->datatype),
-                 ReadScalar(p + fz->offset, fz->datatype));
+  out.points.reserve(c.points);
+  if (layout.time) out.times_ns.reserve(c.points);
+  for (size_t i = 0; i < c.points; ++i) {
+    const Vec3 x(detail::ReadAsDouble(c, i, *fx), detail::ReadAsDouble(c, i, *fy),
+                 detail::ReadAsDouble(c, i, *fz));
     if (!x.allFinite()) {
       ++out.dropped_non_finite;
       continue;
@@ -206,12 +93,24 @@ PointCloud FromCloud2(const pcl::PCLPointCloud2& c, const std::string& path,
     out.points.push_back(x);
     if (layout.time) {
       int64_t t = 0;
-      if (!PointTimeNs(layout, p, options.stamp_ns, &t))
-        Fail(path, "point " + std::to_string(i) + ": non-finite time");
+      if (!PointTimeNs(layout, c.data.data() + i * c.point_step, options.stamp_ns, &t)) {
+        throw UnusableCloudError(path + ": point " + std::to_string(i) +
+                                 ": time is not finite or outside int64 ns");
+      }
       out.times_ns.push_back(t);
     }
-    if (fi) out.intensity.push_back(float(ReadScalar(p + fi->offset, fi->datatype)));
-    if (fr) out.ring.push_back(uint16_t(ReadScalar(p + fr->offset, fr->datatype)));
+    if (fi) {
+      const double v = detail::ReadAsDouble(c, i, *fi);
+      out.intensity.push_back(std::abs(v) <= std::numeric_limits<float>::max() ? float(v) : NAN);
+    }
+    if (fr) {
+      const double v = detail::ReadAsDouble(c, i, *fr);
+      if (!(v >= 0.0 && v <= 65535.0)) {  // also false for NaN: never cast it to an integer
+        Fail(path, "point " + std::to_string(i) + ": ring " + std::to_string(v) +
+                       " is not in [0, 65535]");
+      }
+      out.ring.push_back(uint16_t(v));
+    }
   }
   return out;
 }
@@ -260,19 +159,12 @@ void CheckCloud(const PointCloud& cloud, const std::string& path) {
 
 PointCloud ReadPcd(const std::string& path, const ReadOptions& options) {
   RequireFile(path);
-  pcl::PCLPointCloud2 c;
-  const int line = CheckPcdHeader(path);
-  pcl::PCDReader reader;
-  if (reader.read(path, c) < 0) Fail(path, "PCL could not parse the PCD data");
-  return FromCloud2(c, path, options, "line " + std::to_string(line) + " (FIELDS): ");
+  return FromRaw(detail::ReadPcdRaw(path), path, options);
 }
 
 PointCloud ReadPly(const std::string& path, const ReadOptions& options) {
   RequireFile(path);
-  pcl::PCLPointCloud2 c;
-  pcl::PLYReader reader;
-  if (reader.read(path, c) < 0) Fail(path, "PCL could not parse the PLY header or data");
-  return FromCloud2(c, path, options, "header (element vertex properties): ");
+  return FromRaw(detail::ReadPlyRaw(path), path, options);
 }
 
 PointCloud ReadPointCloud(const std::string& path, const ReadOptions& options) {
@@ -313,7 +205,7 @@ PointCloud ReadKittiBin(const std::string& path, int floats_per_point,
                            std::to_string(n) + " points in " + path);
     }
     times.resize(n);
-    std::memcpy(times.data(), tb.data(), tb.size());
+    if (n > 0) std::memcpy(times.data(), tb.data(), tb.size());
   }
   PointCloud out;
   out.stamp_ns = stamp_ns;
@@ -330,8 +222,12 @@ PointCloud ReadKittiBin(const std::string& path, int floats_per_point,
     out.points.push_back(x);
     if (floats_per_point >= 4) out.intensity.push_back(v[3]);
     if (!times.empty()) {
-      if (!std::isfinite(times[i])) Fail(times_path, "value " + std::to_string(i) + " not finite");
-      out.times_ns.push_back(stamp_ns + std::llround(double(times[i]) * 1e9));
+      int64_t offset = 0, t = 0;
+      if (!SecondsToNs(double(times[i]), &offset) || __builtin_add_overflow(stamp_ns, offset, &t)) {
+        throw UnusableCloudError(times_path + ": value " + std::to_string(i) + " (" +
+                                 std::to_string(times[i]) + ") is not a valid time");
+      }
+      out.times_ns.push_back(t);
     }
   }
   return out;
@@ -391,8 +287,7 @@ void WritePly(const std::string& path, const PointCloud& cloud) {
 void WriteKittiBin(const std::string& path, const PointCloud& cloud,
                    const std::string& times_path) {
   CheckCloud(cloud, path);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) Fail(path, "cannot open for writing");
+  std::ofstream out = OpenForWriting(path, std::ios::binary | std::ios::trunc);
   const size_t n = cloud.size();
   for (size_t i = 0; i < n; ++i) {
     const float v[4] = {float(cloud.points[i].x()), float(cloud.points[i].y()),
@@ -400,16 +295,15 @@ void WriteKittiBin(const std::string& path, const PointCloud& cloud,
                         cloud.intensity.size() == n ? cloud.intensity[i] : 0.f};
     out.write(reinterpret_cast<const char*>(v), sizeof(v));
   }
-  if (!out) Fail(path, "write failed");
+  CloseChecked(out, path);
   if (!times_path.empty()) {
-    std::ofstream tout(times_path, std::ios::binary);
-    if (!tout) Fail(times_path, "cannot open for writing");
+    std::ofstream tout = OpenForWriting(times_path, std::ios::binary | std::ios::trunc);
     for (size_t i = 0; i < n; ++i) {
       const float s =
           cloud.has_times() ? float(1e-9 * double(cloud.times_ns[i] - cloud.stamp_ns)) : 0.f;
       tout.write(reinterpret_cast<const char*>(&s), sizeof(s));
     }
-    if (!tout) Fail(times_path, "write failed");
+    CloseChecked(tout, times_path);
   }
 }
 

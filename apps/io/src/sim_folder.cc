@@ -3,6 +3,8 @@
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 
@@ -36,15 +39,19 @@ PointCloud ReadSimScan(const std::string& path, int64_t start_ns) {
     uint32_t dt;
     std::memcpy(v, bytes.data() + 16 * i, 12);
     std::memcpy(&dt, bytes.data() + 16 * i + 12, 4);
-    c.points.emplace_back(v[0], v[1], v[2]);
+    const Vec3 x(v[0], v[1], v[2]);
+    if (!x.allFinite()) {  // recovery, as for every point-cloud file
+      ++c.dropped_non_finite;
+      continue;
+    }
+    c.points.push_back(x);
     c.times_ns.push_back(start_ns + int64_t(dt));
   }
   return c;
 }
 
 void WriteSimScan(const std::string& path, const PointCloud& cloud) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  std::ofstream out = OpenForWriting(path, std::ios::binary | std::ios::trunc);
   std::vector<char> buf(16 * cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
     const float v[3] = {float(cloud.points[i].x()), float(cloud.points[i].y()),
@@ -58,10 +65,10 @@ void WriteSimScan(const std::string& path, const PointCloud& cloud) {
     std::memcpy(buf.data() + 16 * i + 12, &u, 4);
   }
   out.write(buf.data(), std::streamsize(buf.size()));
-  if (!out) throw std::runtime_error(path + ": write failed");
+  CloseChecked(out, path);
 }
 
-SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_ns)
+SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_error_ns)
     : folder_(folder) {
   const fs::path dir(folder);
   std::error_code ec;
@@ -74,10 +81,20 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       throw std::runtime_error("key 'format' is not 'ctlio_sim'");
     }
     gravity_ = meta["gravity"].as<double>();
+    if (!(gravity_ > 0.0 && gravity_ < 100.0)) {
+      throw std::runtime_error("gravity " + std::to_string(gravity_) + " is not in (0, 100) m/s²");
+    }
     const auto t = meta["imu_from_lidar"]["translation"].as<std::vector<double>>();
     const auto q = meta["imu_from_lidar"]["quaternion_xyzw"].as<std::vector<double>>();
     if (t.size() != 3 || q.size() != 4) throw std::runtime_error("imu_from_lidar: wrong sizes");
-    imu_from_lidar_ = SE3(Eigen::Quaterniond(q[3], q[0], q[1], q[2]), Vec3(t[0], t[1], t[2]));
+    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+    const Vec3 r(t[0], t[1], t[2]);
+    // A zero (or non-unit) quaternion is no rotation: Eigen would silently give identity.
+    if (!r.allFinite() || !(std::abs(quat.norm() - 1.0) <= 1e-3)) {
+      throw std::runtime_error("imu_from_lidar: translation not finite or quaternion norm " +
+                               std::to_string(quat.norm()) + " is not 1");
+    }
+    imu_from_lidar_ = SE3(quat.normalized(), r);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(meta_path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   } catch (const std::runtime_error& e) {
@@ -89,7 +106,8 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
     ExpectFields(scans_path, row, 5);
     ScanEntry e{row.line, ToInt64(scans_path, row, 1), ToInt64(scans_path, row, 2),
                 size_t(ToInt64(scans_path, row, 3)), (dir / row.fields[4]).string()};
-    if (e.end_ns < e.start_ns) FailAt(scans_path, row.line, "end_ns before start_ns");
+    if (e.end_ns <= e.start_ns) FailAt(scans_path, row.line, "end_ns not after start_ns");
+    if (ToInt64(scans_path, row, 3) < 0) FailAt(scans_path, row.line, "negative point count");
     if (!scans_.empty() && e.start_ns <= scans_.back().start_ns) {
       FailAt(scans_path, row.line,
              "scan out of order (start " + std::to_string(e.start_ns) + " ns not after " +
@@ -112,7 +130,7 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
     lines.push_back(row.line);
   }
   if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
-  CheckImuStream(imu_path, lines, max_imu_gap_ns, &imu_);
+  CheckImuStream(imu_path, lines, max_imu_gap_error_ns, &imu_);
 
   const std::string gt_path = (dir / "ground_truth.csv").string();
   if (fs::is_regular_file(gt_path, ec)) {
@@ -135,11 +153,15 @@ bool SimFolderReader::Next(ScanFrame* frame) {
   const ScanEntry& e = scans_[next_];
   frame->index = next_;
   frame->cloud = ReadSimScan(e.file, e.start_ns);
-  if (frame->cloud.size() != e.points) {
+  if (frame->cloud.size() + frame->cloud.dropped_non_finite != e.points) {
     FailAt(folder_ + "/scans.csv", e.line,
            "lists " + std::to_string(e.points) + " points, " + e.file + " has " +
-               std::to_string(frame->cloud.size()));
+               std::to_string(frame->cloud.size() + frame->cloud.dropped_non_finite));
   }
+  // Recovery as in the Newer College reader: points timed outside the scan's interval (± 10 % of
+  // its length) are dropped with a warning naming the file.
+  const int64_t tolerance = std::max<int64_t>((e.end_ns - e.start_ns) / 10, 1);
+  DropPointsOutside(e.file, e.start_ns - tolerance, e.end_ns + tolerance, &frame->cloud);
   frame->start_ns = e.start_ns;
   frame->end_ns = e.end_ns;
   frame->imu.clear();
@@ -174,13 +196,13 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     y << YAML::EndMap;
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
-    std::ofstream out(dir / "ctlio_sim.yaml");
-    out << "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n"
-        << y.c_str() << "\n";
-    if (!out) throw std::runtime_error((dir / "ctlio_sim.yaml").string() + ": write failed");
+    WriteTextFile((dir / "ctlio_sim.yaml").string(),
+                  "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" +
+                      std::string(y.c_str()) + "\n");
   }
-  std::ofstream imu(dir / "imu.csv"), scans(dir / "scans.csv");
-  if (!imu || !scans) throw std::runtime_error(folder + ": cannot write imu.csv/scans.csv");
+  const std::string imu_path = (dir / "imu.csv").string(),
+                    scans_path = (dir / "scans.csv").string();
+  std::ofstream imu = OpenForWriting(imu_path), scans = OpenForWriting(scans_path);
   imu << "t_ns,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
   scans << "index,start_ns,end_ns,points,file\n";
   ScanFrame frame;
@@ -200,9 +222,11 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     ++n;
     if (progress) progress(n, source.NumScans());
   }
-  if (!imu || !scans) throw std::runtime_error(folder + ": write failed");
+  CloseChecked(imu, imu_path);
+  CloseChecked(scans, scans_path);
   if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
-    std::ofstream out(dir / "ground_truth.csv");
+    const std::string gt_path = (dir / "ground_truth.csv").string();
+    std::ofstream out = OpenForWriting(gt_path);
     out << "t_ns,x,y,z,qx,qy,qz,qw\n" << std::setprecision(17);
     for (const auto& p : *gt) {
       const Eigen::Quaterniond q = p.pose.quaternion();
@@ -210,6 +234,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
       out << p.t_ns << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ',' << q.y()
           << ',' << q.z() << ',' << q.w() << '\n';
     }
+    CloseChecked(out, gt_path);
     WriteTum((dir / "ground_truth_tum.txt").string(), *gt);
   }
   return n;

@@ -35,6 +35,8 @@ std::vector<TableRow> ReadTable(const std::string& path, bool skip_header) {
   std::string line;
   bool first = true;
   for (int n = 1; std::getline(in, line); ++n) {
+    // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first field.
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     // Tolerated: CRLF line ends, trailing blanks and one trailing comma (common in exports).
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
       line.pop_back();
@@ -66,10 +68,12 @@ std::vector<TableRow> ReadTable(const std::string& path, bool skip_header) {
     row.fields = std::move(kept);
     if (row.fields.empty() || row.fields[0].rfind("#", 0) == 0) continue;
     if (first && skip_header) {
+      // A header names columns: no field of it is a number. A data row always has one (a row of
+      // scans.csv ends in a file name, so "any field not a number" would drop it).
       first = false;
-      bool numeric = true;
-      for (const auto& f : row.fields) numeric = numeric && IsNumber(f);
-      if (!numeric) continue;
+      bool any_number = false;
+      for (const auto& f : row.fields) any_number = any_number || IsNumber(f);
+      if (!any_number) continue;
     }
     first = false;
     rows.push_back(std::move(row));

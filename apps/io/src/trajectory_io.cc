@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/text_table.h"
 
 namespace ctlio::io {
@@ -45,8 +46,7 @@ std::vector<StampedPose> ReadTum(const std::string& path) {
 }
 
 void WriteTum(const std::string& path, const std::vector<StampedPose>& poses) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  std::ofstream out = OpenForWriting(path);
   out << "# t x y z qx qy qz qw\n" << std::setprecision(17);
   for (const auto& p : poses) {
     const Eigen::Quaterniond q = p.pose.quaternion();
@@ -54,7 +54,7 @@ void WriteTum(const std::string& path, const std::vector<StampedPose>& poses) {
     out << FormatSecondsNs(p.t_ns) << ' ' << r.x() << ' ' << r.y() << ' ' << r.z() << ' ' << q.x()
         << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << '\n';
   }
-  if (!out) throw std::runtime_error(path + ": write failed");
+  CloseChecked(out, path);
 }
 
 std::vector<StampedPose> ReadKittiPoses(const std::string& path, const std::string& times_path) {
@@ -90,8 +90,7 @@ std::vector<StampedPose> ReadKittiPoses(const std::string& path, const std::stri
 }
 
 void WriteKittiPoses(const std::string& path, const std::vector<StampedPose>& poses) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  std::ofstream out = OpenForWriting(path);
   out << std::setprecision(12);
   for (const auto& p : poses) {
     const Mat4 T = p.pose.Matrix();
@@ -99,7 +98,7 @@ void WriteKittiPoses(const std::string& path, const std::vector<StampedPose>& po
       for (int b = 0; b < 4; ++b) out << T(a, b) << (a == 2 && b == 3 ? '\n' : ' ');
     }
   }
-  if (!out) throw std::runtime_error(path + ": write failed");
+  CloseChecked(out, path);
 }
 
 std::vector<StampedPose> ReadTrajectory(const std::string& path,

@@ -64,21 +64,34 @@ class DataSource {
 void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cursor,
                   std::vector<ImuSample>* out);
 
+// Recovery shared by the readers: drops the points of `cloud` timed outside [lo_ns, hi_ns] (the
+// scan's interval with a tolerance), with a warning naming `path`. Returns how many.
+size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* cloud);
+
 // Checks an IMU stream read from `path` (lines[i] = line number of imu[i]) and applies the
 // documented recoveries, logged with glog:
 //   * a sample with the same time as the previous one (duplicate) is dropped, with a warning;
 //   * a time going backwards is an error "<path>:<line>: IMU time goes backwards ...";
-//   * a gap larger than `max_gap_ns` is an error "<path>:<line>: gap of ... in the IMU" (0 = off).
-void CheckImuStream(const std::string& path, const std::vector<int>& lines, int64_t max_gap_ns,
-                    std::vector<ImuSample>* imu);
+//   * a gap (spacing above 3× the median) is a warning "<path>:<line>: gap of ... s in the IMU"
+//     and the samples are handed on; with `max_gap_error_ns` > 0 a gap longer than that is an
+//     error "<path>:<line>: gap of ... in the IMU" (opt-in: --max_imu_gap_error).
+void CheckImuStream(const std::string& path, const std::vector<int>& lines,
+                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu);
 
 // Decimal seconds (as in TUM files) to int64 ns without going through double, so that
 // 1583836591.182590000 stays exact. Returns false if `s` is not a decimal number.
 bool ParseSecondsNs(const std::string& s, int64_t* ns);
 std::string FormatSecondsNs(int64_t ns);  // "<sec>.<9 digits>"
+// Seconds (double) to int64 ns, rounded; false if `s` is not finite or |s| ≥ 9.2e9 s (the int64
+// nanosecond range), where the conversion would overflow.
+bool SecondsToNs(double s, int64_t* ns);
+// sec·10⁹ + nsec with 0 ≤ nsec < 10⁹ and no overflow; false otherwise.
+bool SecNsecToNs(int64_t sec, int64_t nsec, int64_t* ns);
 
 // Opens any supported dataset folder by looking at its contents: Newer College 2020
 // (raw_format/), ctlio simulator (ctlio_sim.yaml) or KITTI (velodyne/). Throws if none matches.
-std::unique_ptr<DataSource> OpenDataset(const std::string& folder);
+// `max_imu_gap_error_ns`: the readers' opt-in IMU gap error (0 = gaps are warnings).
+std::unique_ptr<DataSource> OpenDataset(const std::string& folder,
+                                        int64_t max_imu_gap_error_ns = 0);
 
 }  // namespace ctlio::io

@@ -6,10 +6,13 @@
 //   <seq>/ground_truth/registered_poses.csv   header, then sec, nsec, x y z, qx qy qz qw.
 // Ground truth is read as T_world_lidar. Lidar→IMU: the published extrinsic, overridable.
 //
-// Documented recoveries (logged): duplicate IMU times are dropped; scans are ordered by the stamp
-// in their file names (a directory listing is unordered). Errors (file and line): missing
-// folders/files, malformed CSV lines, a PCD without the 't' field, two scans with one stamp, IMU
-// time going backwards, IMU gaps longer than `max_imu_gap_ns`, ground truth out of order.
+// Documented recoveries (logged): duplicate IMU times are dropped; IMU gaps are reported; scans are
+// ordered by the stamp in their file names (a directory listing is unordered); points whose time
+// is outside [stamp, next stamp] (± 10 % of the scan period) are dropped; a scan without usable
+// points (empty, all non-finite, all at one time, no or a wrongly typed time field) is handed on
+// empty over its nominal interval. Errors (file and line): missing folders/files, malformed CSV
+// lines and PCD files, two scans with one stamp, IMU time going backwards, IMU gaps longer than
+// `max_imu_gap_error_ns` when set, ground truth out of order.
 #pragma once
 
 #include <functional>
@@ -27,8 +30,11 @@ SE3 NewerCollegeImuFromLidar();
 
 struct NewerCollegeOptions {
   SE3 imu_from_lidar = NewerCollegeImuFromLidar();
-  int64_t max_imu_gap_ns = 100'000'000;  // 0.1 s (the Ouster IMU runs at 100 Hz)
-  bool require_ground_truth = false;     // otherwise a missing registered_poses.csv is logged
+  // A gap in the IMU longer than this is an error (file and line); 0 = off (the default): gaps are
+  // logged as warnings and the samples handed on, for the odometry to bridge (it marks the scans
+  // concerned by its own per-scan threshold, OdometryConfig::max_imu_gap).
+  int64_t max_imu_gap_error_ns = 0;
+  bool require_ground_truth = false;  // otherwise a missing registered_poses.csv is logged
 };
 
 class NewerCollegeReader : public DataSource {
@@ -48,11 +54,14 @@ class NewerCollegeReader : public DataSource {
   std::vector<std::pair<int64_t, std::string>> scans_;  // (stamp, path), sorted
   std::vector<ImuSample> imu_;
   std::vector<StampedPose> ground_truth_;
+  int64_t nominal_period_ns_ = 100'000'000;  // median stamp spacing (0.1 s with one scan)
   size_t next_ = 0, imu_cursor_ = 0;
 };
 
 // Writes any data source in the Newer College layout (scan files named cloud_<sec>_<nsec>.pcd,
-// IMU counter from 0, ground truth if the source has it and `write_ground_truth` is set).
+// IMU counter from 0, ground truth if the source has it and `write_ground_truth` is set). The
+// layout cannot carry an extrinsic: a source whose T_imu_lidar is not the published one is
+// refused (the reader would assume the published one).
 // `progress(done, total)` is called after each scan. Returns the number of scans written.
 size_t WriteNewerCollege(DataSource& source, const std::string& sequence_folder,
                          const std::function<void(size_t, size_t)>& progress = {},

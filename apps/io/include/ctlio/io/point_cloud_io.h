@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,15 @@ struct PointCloud {
   double RelativeTime(size_t i) const { return 1e-9 * double(times_ns[i] - stamp_ns); }
 };
 
+// Thrown (instead of a plain std::runtime_error) for a well-formed file that cannot be a timed
+// scan: a time field of the wrong type, times that are not times, no time field where one is
+// required. Dataset readers hand such a scan on as an empty one (documented recovery); malformed
+// files stay errors.
+class UnusableCloudError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // The per-point time field is detected from the field names and types by the drivers'
 // conventions of point_fields.h (Ouster `t`, Livox `offset_time`, Velodyne `time`, Hesai/Robosense
 // and Livox `timestamp`), the same detection as for ROS PointCloud2 messages; `time` overrides it.
@@ -40,9 +50,11 @@ struct ReadOptions {
   const TimeFieldOptions* time = nullptr;  // override of the detected time convention (optional)
 };
 
-// PCD (ascii, binary, binary_compressed) through PCL.
+// PCD (ascii, binary, binary_compressed), read by ctlio itself after the whole file has been
+// checked against its header (sizes, counts, data length, WIDTH×HEIGHT = POINTS < 2^31).
 PointCloud ReadPcd(const std::string& path, const ReadOptions& options = {});
-// PLY (ascii or binary) through PCL; same fields as PCD.
+// PLY (ascii, binary little or big endian), read by ctlio itself (the vertex element's scalar
+// properties, checked against the header); same fields as PCD.
 PointCloud ReadPly(const std::string& path, const ReadOptions& options = {});
 // Dispatch on the extension (.pcd, .ply, .bin).
 PointCloud ReadPointCloud(const std::string& path, const ReadOptions& options = {});

@@ -17,8 +17,9 @@ namespace ctlio::io {
 
 class SimFolderReader : public DataSource {
  public:
-  // `max_imu_gap_ns`: IMU gaps longer than this are errors (0 = no check).
-  explicit SimFolderReader(const std::string& folder, int64_t max_imu_gap_ns = 50'000'000);
+  // `max_imu_gap_error_ns`: IMU gaps longer than this are errors; 0 (default) = gaps are logged
+  // as warnings and the samples handed on (CheckImuStream).
+  explicit SimFolderReader(const std::string& folder, int64_t max_imu_gap_error_ns = 0);
   std::string Name() const override { return "ctlio_sim:" + folder_; }
   size_t NumScans() const override { return scans_.size(); }
   bool Next(ScanFrame* frame) override;

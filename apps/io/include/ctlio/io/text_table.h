@@ -15,9 +15,9 @@ struct TableRow {
 };
 
 // Reads every non-empty line that does not start with '#'. CRLF line ends, trailing blanks and
-// one trailing comma are tolerated; an empty field inside a line is reported by ExpectFields. If
-// `skip_header` is true and the first such line contains a field that is not a number, it is
-// skipped. Throws "<path>: file not found".
+// one trailing comma are tolerated, and so is a UTF-8 byte-order mark; an empty field inside a line
+// is reported by ExpectFields. If `skip_header` is true and no field of the first such line is a
+// number, it is a header and skipped. Throws "<path>: file not found".
 std::vector<TableRow> ReadTable(const std::string& path, bool skip_header);
 
 // Strict conversions: the whole field must parse; otherwise "<path>:<line>: field k ('...') is not

@@ -1,0 +1,114 @@
+// Writes the seed corpora of the fuzz targets from the simulator: a 0.15 s sequence (two scans of
+// 24 points, 30 IMU samples) in every layout, each target's files joined by "%%" lines as the
+// target splits them. Usage: fuzz_make_seeds <corpus_dir> <source_dir> (data/*.yaml are the YAML
+// seeds).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "ctlio/io/newer_college.h"
+#include "ctlio/io/point_cloud_io.h"
+#include "ctlio/io/sim_folder.h"
+#include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/lidar_inertial_sim.h"
+#include "fuzz_common.h"
+
+namespace fs = std::filesystem;
+using namespace ctlio;
+
+namespace {
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::string Join(const std::vector<std::string>& parts) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? "\n%%\n" : "") + parts[i];
+  return out;
+}
+
+void Seed(const fs::path& corpus, const std::string& target, const std::string& name,
+          const std::string& bytes) {
+  fs::create_directories(corpus / target);
+  std::ofstream(corpus / target / name, std::ios::binary) << bytes;
+}
+
+sim::SimConfig Tiny() {
+  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
+  c.duration_s = 0.15;
+  c.lidar.beams = 4;
+  c.lidar.firing_decimation = 300;
+  c.start_ns = 1583836591LL * 1000000000LL + 182590000LL;
+  c.imu_from_lidar = io::NewerCollegeImuFromLidar();
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::cerr << "usage: fuzz_make_seeds <corpus_dir> <source_dir>\n";
+    return 2;
+  }
+  fuzz::QuietLogging();
+  const fs::path corpus(argv[1]), source_dir(argv[2]);
+  const fs::path work = fs::temp_directory_path() / ("ctlio_fuzz_seeds_" + std::to_string(getpid()));
+  fs::remove_all(work);
+  try {
+    sim::SimulatedSource a(Tiny()), b(Tiny());
+    io::WriteSimFolder(a, (work / "ctlio").string());
+    io::WriteNewerCollege(b, (work / "nc").string());
+    const fs::path c = work / "ctlio", n = work / "nc";
+    Seed(corpus, "sim_folder", "sim",
+         Join({Read(c / "ctlio_sim.yaml"), Read(c / "imu.csv"), Read(c / "scans.csv"),
+               Read(c / "scans/000000.bin"), Read(c / "scans/000001.bin"),
+               Read(c / "ground_truth.csv")}));
+    const fs::path scans = n / "raw_format/ouster_zip_files/ouster_scan";
+    const std::string pcd0 = Read(scans / "cloud_1583836591_182590000.pcd");
+    const std::string pcd1 = Read(scans / "cloud_1583836591_282590000.pcd");
+    Seed(corpus, "newer_college", "sim",
+         Join({Read(n / "raw_format/ouster_imu/data.csv"),
+               Read(n / "ground_truth/registered_poses.csv"), pcd0, pcd1}));
+    Seed(corpus, "pcd", "binary", pcd0);
+    const io::PointCloud cloud = io::ReadPcd((scans / "cloud_1583836591_182590000.pcd").string(),
+                                             {Tiny().start_ns, true});
+    std::ostringstream ascii;
+    ascii << "VERSION .7\nFIELDS x y z intensity t ring\nSIZE 4 4 4 4 4 2\nTYPE F F F F U U\n"
+          << "COUNT 1 1 1 1 1 1\nWIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+          << "POINTS " << cloud.size() << "\nDATA ascii\n";
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      ascii << cloud.points[i].x() << ' ' << cloud.points[i].y() << ' ' << cloud.points[i].z()
+            << " 1 " << cloud.times_ns[i] - cloud.stamp_ns << ' ' << cloud.ring[i] << '\n';
+    }
+    Seed(corpus, "pcd", "ascii", ascii.str());
+    io::WritePly((work / "s.ply").string(), cloud);
+    Seed(corpus, "ply", "binary", Read(work / "s.ply"));
+    io::WriteKittiBin((work / "s.bin").string(), cloud, (work / "s_times.bin").string());
+    Seed(corpus, "kitti_bin", "scan", Join({Read(work / "s.bin"), Read(work / "s_times.bin")}));
+    Seed(corpus, "table", "imu", Read(c / "imu.csv"));
+    Seed(corpus, "table", "scans", Read(c / "scans.csv"));
+    const auto gt = *a.GroundTruth();
+    io::WriteKittiPoses((work / "poses.txt").string(), gt);
+    std::string times;
+    for (const auto& p : gt) times += io::FormatSecondsNs(p.t_ns) + "\n";
+    Seed(corpus, "trajectory", "tum", Read(c / "ground_truth_tum.txt"));
+    Seed(corpus, "trajectory", "kitti", Join({Read(work / "poses.txt"), times}));
+    Seed(corpus, "kitti_folder", "sim",
+         Join({"0.0\n0.1\n", Read(work / "s.bin"), Read(work / "s.bin"), Read(work / "s_times.bin"),
+               Read(work / "poses.txt"),
+               "Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"}));
+    for (const auto& e : fs::directory_iterator(source_dir / "data")) {
+      if (e.path().extension() == ".yaml") {
+        Seed(corpus, "yaml_config", e.path().filename().string(), Read(e.path()));
+      }
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "fuzz_make_seeds: " << e.what() << "\n";
+    return 1;
+  }
+  fs::remove_all(work);
+  return 0;
+}

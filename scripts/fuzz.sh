@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (ASan + UBSan) in their own build folder, writes the
+# seed corpora from the simulator and runs every target for SECONDS (default 60) each.
+#   scripts/fuzz.sh [SECONDS] [BUILD_DIR]        (default build dir: build-fuzz)
+#   CTLIO_FUZZ_TARGETS="pcd table" scripts/fuzz.sh 600   runs a subset, 10 minutes each
+# The corpus grows in BUILD_DIR/corpus/<target> across runs; a crash or sanitizer report stops
+# the script with the reproducer in BUILD_DIR/artifacts/ (rerun: BUILD_DIR/fuzz/fuzz_<target>
+# <file>).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+build_dir=${2:-build-fuzz}
+targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config"}
+bash scripts/install_deps.sh
+
+start=$(date +%s)
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
+  -DCTLIO_FUZZ=ON -DCTLIO_BUILD_TESTS=OFF -DCTLIO_BUILD_BENCHMARKS=OFF \
+  ${CMAKE_CXX_COMPILER_LAUNCHER:+-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER} >/dev/null
+cmake --build "$build_dir" -j"$(nproc)" --target fuzz_all
+echo "fuzz: build done in $(( $(date +%s) - start )) s"
+
+corpus="$build_dir/corpus"
+artifacts="$build_dir/artifacts"
+mkdir -p "$corpus" "$artifacts"
+"$build_dir/fuzz/fuzz_make_seeds" "$corpus" "$PWD"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+for t in $targets; do
+  mkdir -p "$corpus/$t"
+  # Inputs that once crashed a target stay in its corpus (fuzz/regressions/<target>_*).
+  for f in fuzz/regressions/"${t}"_*; do [ -e "$f" ] && cp "$f" "$corpus/$t/"; done
+  echo "fuzz: $t for $seconds s"
+  log="$build_dir/fuzz_$t.log"
+  if ! "$build_dir/fuzz/fuzz_$t" "$corpus/$t" -max_total_time="$seconds" -timeout=10 \
+    -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts/$t-" \
+    >"$log" 2>&1; then
+    tail -n 60 "$log"
+    echo "fuzz: $t FAILED (reproducer in $artifacts/, full log $log)"
+    exit 1
+  fi
+  grep -E "^stat::(number_of_executed_units|peak_rss_mb)|^#[0-9]+ +DONE" "$log" | tr '\n' ' '
+  echo
+done
+echo "fuzz: all targets ran $seconds s each without a finding ($(( $(date +%s) - start )) s in all)"
