@@ -107,6 +107,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     o.imu_topic = FLAGS_imu_topic;
     o.preset = FLAGS_preset;
     o.accel_scale = FLAGS_imu_accel_scale;
+    o.max_imu_gap_ns = gap_ns;
     o.time.field = FLAGS_time_field;
     if (!FLAGS_time_unit.empty()) o.time.unit = io::ParseTimeUnit(FLAGS_time_unit);
     if (!FLAGS_time_reference.empty())

@@ -297,11 +297,17 @@ void DecodePoints(const uint8_t* data, size_t n, const PointLayout& layout, int6
       out->times_ns.push_back(t);
     }
     if (layout.intensity) {
-      out->intensity.push_back(
-          float(ReadFieldValue(p + layout.intensity->offset, layout.intensity->datatype)));
+      const double v = ReadFieldValue(p + layout.intensity->offset, layout.intensity->datatype);
+      // A double beyond float's range (or NaN) must not be converted: undefined behaviour.
+      out->intensity.push_back(std::abs(v) <= std::numeric_limits<float>::max() ? float(v) : NAN);
     }
     if (layout.ring) {
-      out->ring.push_back(uint16_t(ReadFieldValue(p + layout.ring->offset, layout.ring->datatype)));
+      const double v = ReadFieldValue(p + layout.ring->offset, layout.ring->datatype);
+      if (!(v >= 0.0 && v <= 65535.0)) {  // also false for NaN: never cast it to an integer
+        throw std::runtime_error(where + "point " + std::to_string(i) + ": ring " +
+                                 std::to_string(v) + " is not in [0, 65535]");
+      }
+      out->ring.push_back(uint16_t(v));
     }
   }
 }

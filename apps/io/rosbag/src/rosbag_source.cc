@@ -278,12 +278,17 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
                              std::to_string(t) + " ns after " + std::to_string(last_imu_ns) +
                              " ns)");
   }
-  if (options.max_imu_gap_ns > 0 && last_imu_ns != INT64_MIN &&
-      t - last_imu_ns > options.max_imu_gap_ns) {
-    throw std::runtime_error(Where(imu_topic, imu_messages) + "gap of " +
-                             std::to_string(1e-9 * double(t - last_imu_ns)) +
-                             " s in the IMU (limit " +
-                             std::to_string(1e-9 * double(options.max_imu_gap_ns)) + " s)");
+  if (last_imu_ns != INT64_MIN && t - last_imu_ns > options.imu_gap_warning_ns) {
+    const double gap = 1e-9 * double(t - last_imu_ns);
+    // Opt-in error; by default the samples are handed on and the odometry bridges the hole
+    // (README, "IMU gaps").
+    if (options.max_imu_gap_ns > 0 && t - last_imu_ns > options.max_imu_gap_ns) {
+      throw std::runtime_error(Where(imu_topic, imu_messages) + "gap of " + std::to_string(gap) +
+                               " s in the IMU (limit " +
+                               std::to_string(1e-9 * double(options.max_imu_gap_ns)) + " s)");
+    }
+    LOG(WARNING) << Where(imu_topic, imu_messages) << "gap of " << gap
+                 << " s in the IMU; samples handed on";
   }
   last_imu_ns = t;
   ImuSample s;

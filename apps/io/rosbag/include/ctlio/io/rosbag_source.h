@@ -18,8 +18,9 @@
 // Bad input (std::runtime_error naming the bag and, where it applies, the topic and message
 // number): not a bag, a truncated or corrupted bag (the library's error is passed on), a missing
 // or ambiguous topic, a topic of the wrong type, a cloud that does not decode (point_fields.h),
-// IMU time going backwards, IMU gaps longer than `max_imu_gap_ns`, scans out of order. Duplicate
-// IMU times are dropped with a warning.
+// IMU time going backwards, IMU gaps longer than `max_imu_gap_ns` (opt-in; otherwise gaps are
+// warnings and the samples are handed on), scans out of order. Duplicate IMU times are dropped
+// with a warning.
 #pragma once
 
 #include <functional>
@@ -45,7 +46,8 @@ struct RosbagOptions {
   std::string lidar_topic, imu_topic;  // empty: the only topic of that type, or the preset's
   std::string preset;                  // empty: recognised from the topics (or none)
   TimeFieldOptions time;
-  int64_t max_imu_gap_ns = 100'000'000;  // 0 = no check
+  int64_t max_imu_gap_ns = 0;  // opt-in error for a longer IMU gap; 0 = off (gaps are warned about)
+  int64_t imu_gap_warning_ns = 100'000'000;  // a longer gap is logged as a warning
   // Multiplies the accelerometer: 9.80665 for IMUs that report g (Livox), whose mean specific
   // force near 1 is warned about.
   double accel_scale = 1.0;
