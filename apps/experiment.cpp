@@ -272,10 +272,17 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, double>> scenarios;
     if (FLAGS_imu_outage.empty() || FLAGS_nominal) scenarios.push_back({"none", 0.0});
     for (const auto& text : Split(FLAGS_imu_outage)) {
-      const double length = std::stod(text);
-      if (!(length > 0 && length < FLAGS_duration)) {
-        throw std::runtime_error("--imu_outage: length '" + text +
-                                 "' must be positive and shorter than --duration");
+      size_t used = 0;
+      double length = NAN;
+      try {
+        length = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != text.size() || !(length > 0 && length < FLAGS_duration)) {
+        throw std::runtime_error(
+            "--imu_outage: length '" + text +
+            "' must be a number of seconds, positive and shorter than --duration");
       }
       std::ostringstream name;
       name << "outage_" << length << "s";
