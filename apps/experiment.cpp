@@ -9,6 +9,14 @@
 //
 // The reduced flags are for quick runs: the table records them in its header so that a reduced
 // table is never mistaken for the full one.
+//
+// IMU dropout: --imu_outage 0.2,0.5,1,2 adds one scenario per length, an outage of that length
+// centred on the sequence midpoint (the "none" scenario is kept unless --nominal=false).
+//
+// Split jobs: each job writes OUT/results.csv (one line per run) and OUT/settings.txt; run
+// subsets (--regimes, --methods, --first_sequence, --sequences) as separate jobs and pool them:
+//   ctlio_experiment --merge DIR1,DIR2,... --out DIR
+// writes the table of all their runs (the settings of the jobs must be equal).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -20,6 +28,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <tuple>
@@ -27,6 +36,7 @@
 #include "ctlio/io/checked_output.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "lio/experiment_results.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(out, "", "Output folder (required)");
@@ -42,6 +52,13 @@ DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resol
 DEFINE_int32(threads, 0, "Parallel runs (0 = number of cores)");
 DEFINE_bool(body_centric, false, "Simulate the paper's body-centric accelerometer model");
 DEFINE_double(failure_ate, 1.0, "A run whose ATE exceeds this [m] counts as a failure");
+DEFINE_string(imu_outage, "",
+              "Comma-separated IMU outage lengths [s]: one scenario per length, the outage "
+              "centred on the sequence midpoint");
+DEFINE_bool(nominal, true, "With --imu_outage: also run the scenario without outage");
+DEFINE_string(merge, "",
+              "Comma-separated output folders of earlier jobs: pool their results.csv into the "
+              "table of --out instead of running");
 
 namespace {
 
@@ -61,6 +78,8 @@ struct Job {
   std::string regime;
   int index = 0;
   std::string method;
+  std::string scenario;
+  double outage_s = 0.0;  // 0 = none
   lioapp::RunSummary run;
   bool done = false;
   std::string error;
@@ -127,6 +146,108 @@ void WriteBarSvg(const std::string& path,
   io::CloseChecked(f, path);
 }
 
+// The settings that must be equal for runs to be pooled, one "key value" per line.
+std::string SettingsText(const std::string& config_path) {
+  std::ostringstream s;
+  s << "world " << FLAGS_world << "\nduration_s " << FLAGS_duration << "\nbeams " << FLAGS_beams
+    << "\nfiring_decimation " << FLAGS_firing_decimation << "\nimu_model "
+    << (FLAGS_body_centric ? "body-centric" : "exact-specific-force") << "\nconfig "
+    << std::filesystem::path(config_path).filename().string() << "\nfailure_ate_m "
+    << FLAGS_failure_ate << "\n";
+  return s.str();
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot open (not an experiment output folder?)");
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::map<std::string, std::string> ParseSettings(const std::string& text) {
+  std::map<std::string, std::string> kv;
+  std::istringstream in(text);
+  std::string key, value;
+  while (in >> key >> value) kv[key] = value;
+  return kv;
+}
+
+// OUT/table.md, OUT/pooled.csv and OUT/table2.svg from the per-run rows.
+void WriteTable(const std::string& out, const std::string& settings,
+                const std::vector<lioapp::RunRow>& rows, const std::string& provenance) {
+  const auto kv = ParseSettings(settings);
+  std::map<std::string, std::set<int>> sequences;
+  for (const auto& r : rows) sequences[r.regime].insert(r.sequence);
+  size_t per_regime = 0;
+  int lo = 1 << 30, hi = -1;
+  for (const auto& [regime, set] : sequences) {
+    per_regime = per_regime == 0 ? set.size() : std::min(per_regime, set.size());
+    lo = std::min(lo, *set.begin());
+    hi = std::max(hi, *set.rbegin());
+  }
+  std::ostringstream md;
+  md << "# Table II (ctlio): RMSE ATE [m] per regime, method and scenario, world " << kv.at("world")
+     << "\n\nSettings: " << per_regime << " sequences per regime (indices " << lo << "–" << hi
+     << "), " << kv.at("duration_s") << " s each, " << kv.at("beams")
+     << " beams, firing decimation " << kv.at("firing_decimation") << ", " << kv.at("imu_model")
+     << " IMU, config " << kv.at("config") << ". ";
+  const bool full = per_regime >= 20 && std::stod(kv.at("duration_s")) >= 20 &&
+                    std::stoi(kv.at("beams")) >= 128 && kv.at("firing_decimation") == "1";
+  md << (full ? "Full paper settings.\n\n"
+              : "**REDUCED settings** (not the paper's 20 × 20 s × 128 beams).\n\n");
+  const auto cells = lioapp::PoolRows(rows);
+  md << lioapp::PooledTableMarkdown(cells);
+  md << "\n"
+     << provenance << " A failure is a run with a failed scan or an ATE above "
+     << kv.at("failure_ate_m") << " m. Scenario outage_Ls: no IMU samples for L s centred on the "
+     << "sequence midpoint.\n";
+  io::WriteTextFile(out + "/table.md", md.str());
+  std::printf("%s", md.str().c_str());
+  lioapp::WritePooledCsv(out + "/pooled.csv", cells);
+  std::vector<std::tuple<std::string, std::string, double>> bars;
+  std::vector<std::string> regimes, methods;
+  for (const auto& c : cells) {
+    if (c.scenario != cells.front().scenario) continue;
+    bars.emplace_back(c.regime, c.method, c.rmse_all);
+    if (std::find(regimes.begin(), regimes.end(), c.regime) == regimes.end())
+      regimes.push_back(c.regime);
+    if (std::find(methods.begin(), methods.end(), c.method) == methods.end())
+      methods.push_back(c.method);
+  }
+  WriteBarSvg(out + "/table2.svg", bars, regimes, methods);
+}
+
+// --merge: pool the results of earlier jobs with equal settings.
+void Merge() {
+  std::string settings;
+  std::vector<lioapp::RunRow> rows;
+  std::set<std::tuple<std::string, int, std::string, std::string>> seen;
+  const auto dirs = Split(FLAGS_merge);
+  for (const std::string& dir : dirs) {
+    const std::string s = ReadText(dir + "/settings.txt");
+    if (settings.empty()) settings = s;
+    if (s != settings) {
+      throw std::runtime_error(dir + "/settings.txt: settings differ from " + dirs.front() +
+                               "/settings.txt; runs with different settings cannot be pooled");
+    }
+    for (const auto& r : lioapp::ReadResultsCsv(dir + "/results.csv")) {
+      if (!seen.insert({r.regime, r.sequence, r.method, r.scenario}).second) {
+        throw std::runtime_error(dir + "/results.csv: run " + r.regime + "/" +
+                                 std::to_string(r.sequence) + " " + r.method + " " + r.scenario +
+                                 " appears in more than one job");
+      }
+      rows.push_back(r);
+    }
+  }
+  if (rows.empty()) throw std::runtime_error("--merge: no runs in " + FLAGS_merge);
+  std::filesystem::create_directories(FLAGS_out);
+  io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
+  lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
+  WriteTable(FLAGS_out, settings, rows,
+             "Merged from " + std::to_string(dirs.size()) + " jobs (" + FLAGS_merge + ").");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -136,6 +257,10 @@ int main(int argc, char** argv) {
   FLAGS_logtostderr = true;
   try {
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
+    if (!FLAGS_merge.empty()) {
+      Merge();
+      return 0;
+    }
     std::filesystem::create_directories(FLAGS_out);
     const std::string config_path =
         FLAGS_config.empty() ? std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml" : FLAGS_config;
@@ -145,14 +270,43 @@ int main(int argc, char** argv) {
     for (const auto& r : regimes) sim::ParseRegime(r);
     sim::ParseWorld(FLAGS_world);
     for (const auto& m : methods) lio::ParseLioMethod(m);
+    // Scenarios: (name, outage length); the nominal one first.
+    std::vector<std::pair<std::string, double>> scenarios;
+    if (FLAGS_imu_outage.empty() || FLAGS_nominal) scenarios.push_back({"none", 0.0});
+    for (const auto& text : Split(FLAGS_imu_outage)) {
+      size_t used = 0;
+      double length = NAN;
+      try {
+        length = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != text.size() || !(length > 0 && length < FLAGS_duration)) {
+        throw std::runtime_error(
+            "--imu_outage: length '" + text +
+            "' must be a number of seconds, positive and shorter than --duration");
+      }
+      std::ostringstream name;
+      name << "outage_" << length << "s";
+      scenarios.push_back({name.str(), length});
+    }
 
     std::vector<Job> jobs;
-    // Slow jobs first (fast regime, all methods) so that the tail of the schedule is short.
-    for (auto r = regimes.rbegin(); r != regimes.rend(); ++r) {
+    for (const auto& r : regimes) {
       for (int i = FLAGS_first_sequence; i < FLAGS_first_sequence + FLAGS_sequences; ++i) {
-        for (const auto& m : methods) jobs.push_back({*r, i, m});
+        for (const auto& [scenario, length] : scenarios) {
+          for (const auto& m : methods) jobs.push_back({r, i, m, scenario, length});
+        }
       }
     }
+    // Slow jobs first (the last regime, fast, with all methods) so that the tail of the
+    // schedule is short; the results keep the order above.
+    std::vector<size_t> order(jobs.size());
+    for (size_t j = 0; j < jobs.size(); ++j) order[j] = j;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return std::find(regimes.begin(), regimes.end(), jobs[a].regime) >
+             std::find(regimes.begin(), regimes.end(), jobs[b].regime);
+    });
     const int threads =
         FLAGS_threads > 0 ? FLAGS_threads : std::max(1u, std::thread::hardware_concurrency());
     std::atomic<size_t> next{0};
@@ -160,8 +314,8 @@ int main(int argc, char** argv) {
     std::mutex print;
     const auto start = std::chrono::steady_clock::now();
     auto worker = [&]() {
-      for (size_t j = next++; j < jobs.size(); j = next++) {
-        Job& job = jobs[j];
+      for (size_t k = next++; k < jobs.size(); k = next++) {
+        Job& job = jobs[order[k]];
         try {
           sim::SimConfig c =
               sim::ExperimentConfig(sim::ParseRegime(job.regime), job.index, sim::kExperimentSeed,
@@ -170,6 +324,9 @@ int main(int argc, char** argv) {
           c.lidar.beams = FLAGS_beams;
           c.lidar.firing_decimation = FLAGS_firing_decimation;
           c.imu.body_centric = FLAGS_body_centric;
+          if (job.outage_s > 0) {
+            c.imu.outages.push_back({0.5 * (FLAGS_duration - job.outage_s), job.outage_s});
+          }
           sim::SimulatedSource source(c, "sim:" + job.regime + "/" + std::to_string(job.index));
           lio::OdometryConfig config = base;
           config.method = lio::ParseLioMethod(job.method);
@@ -182,14 +339,14 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> lock(print);
         const double el =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::fprintf(stderr, "[%zu/%zu %6.0f s] %-6s %2d %-10s ", n, jobs.size(), el,
-                     job.regime.c_str(), job.index, job.method.c_str());
+        std::fprintf(stderr, "[%zu/%zu %6.0f s] %-6s %2d %-10s %-12s ", n, jobs.size(), el,
+                     job.regime.c_str(), job.index, job.method.c_str(), job.scenario.c_str());
         if (!job.done) {
           std::fprintf(stderr, "ERROR %s\n", job.error.c_str());
         } else {
-          std::fprintf(stderr, "ATE %.4f m  failed scans %d  median %.1f ms%s\n",
-                       job.run.ate ? job.run.ate->rmse : NAN, job.run.failed, job.run.median_ms,
-                       job.run.failure ? "  FAILURE" : "");
+          std::fprintf(stderr, "ATE %.4f m  failed scans %d  gap scans %d  median %.1f ms%s\n",
+                       job.run.ate ? job.run.ate->rmse : NAN, job.run.failed, job.run.imu_gaps,
+                       job.run.median_ms, job.run.failure ? "  FAILURE" : "");
         }
       }
     };
@@ -197,77 +354,35 @@ int main(int argc, char** argv) {
     for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();
 
-    // Per run.
-    std::ofstream csv = io::OpenForWriting(FLAGS_out + "/results.csv");
-    csv << "regime,sequence,method,ate_rmse_m,ate_pairs,failed_scans,degenerate_scans,failure,"
-           "median_ms,p95_ms,max_ms,median_cpu_ms,p95_cpu_ms,error\n";
+    std::vector<lioapp::RunRow> rows;
     for (const Job& j : jobs) {
-      csv << j.regime << ',' << j.index << ',' << j.method << ','
-          << (j.done && j.run.ate ? j.run.ate->rmse : NAN) << ','
-          << (j.done && j.run.ate ? j.run.ate->pairs : 0) << ',' << j.run.failed << ','
-          << j.run.degenerate << ',' << (!j.done || j.run.failure ? 1 : 0) << ',' << j.run.median_ms
-          << ',' << j.run.p95_ms << ',' << j.run.max_ms << ',' << j.run.median_cpu_ms << ','
-          << j.run.p95_cpu_ms << ",\"" << j.error << "\"\n";
+      lioapp::RunRow r;
+      r.regime = j.regime;
+      r.sequence = j.index;
+      r.method = j.method;
+      r.scenario = j.scenario;
+      r.ate_rmse_m = j.done && j.run.ate ? j.run.ate->rmse : NAN;
+      r.ate_pairs = j.done && j.run.ate ? j.run.ate->pairs : 0;
+      r.failed_scans = j.run.failed;
+      r.degenerate_scans = j.run.degenerate;
+      r.imu_gap_scans = j.run.imu_gaps;
+      r.failure = !j.done || j.run.failure;
+      r.median_ms = j.run.median_ms;
+      r.p95_ms = j.run.p95_ms;
+      r.max_ms = j.run.max_ms;
+      r.median_cpu_ms = j.run.median_cpu_ms;
+      r.p95_cpu_ms = j.run.p95_cpu_ms;
+      r.error = j.error;
+      rows.push_back(r);
     }
-    io::CloseChecked(csv, FLAGS_out + "/results.csv");
-    // Table: overall RMSE = sqrt(Σ n_i·rmse_i² / Σ n_i) over the runs of a regime that did not
-    // fail (so one diverged run is counted as a failure and does not swamp the mean), and the
-    // same over all runs for completeness.
-    std::ostringstream md;
-    md << "# Table II (ctlio): RMSE ATE [m] per regime and method, world " << FLAGS_world << "\n\n";
-    md << "Settings: " << FLAGS_sequences << " sequences per regime (from index "
-       << FLAGS_first_sequence << "), " << FLAGS_duration << " s each, " << FLAGS_beams
-       << " beams, firing decimation " << FLAGS_firing_decimation << ", "
-       << (FLAGS_body_centric ? "body-centric" : "exact specific-force") << " IMU, config "
-       << std::filesystem::path(config_path).filename().string() << ". ";
-    const bool full = FLAGS_sequences >= 20 && FLAGS_duration >= 20 && FLAGS_beams >= 128 &&
-                      FLAGS_firing_decimation == 1;
-    md << (full ? "Full paper settings.\n\n"
-                : "**REDUCED settings** (not the paper's 20 × 20 s × 128 beams).\n\n");
-    md << "| regime | method | RMSE ATE (non-failed) [m] | RMSE ATE (all) [m] | failures | median "
-          "ms/scan (wall) | p95 ms/scan (wall) | median CPU ms/scan |\n"
-          "|---|---|---|---|---|---|---|---|\n";
-    std::vector<std::tuple<std::string, std::string, double>> bars;
-    for (const auto& r : regimes) {
-      for (const auto& m : methods) {
-        double s_ok = 0, n_ok = 0, s_all = 0, n_all = 0;
-        int failures = 0;
-        std::vector<double> med, p95, cpu;
-        for (const Job& j : jobs) {
-          if (j.regime != r || j.method != m) continue;
-          if (!j.done || j.run.failure) ++failures;
-          if (!j.done || !j.run.ate) continue;
-          const double n = double(j.run.ate->pairs);
-          const double e2 = j.run.ate->rmse * j.run.ate->rmse;
-          if (std::isfinite(e2)) {
-            s_all += n * e2;
-            n_all += n;
-            if (!j.run.failure) {
-              s_ok += n * e2;
-              n_ok += n;
-            }
-          }
-          med.push_back(j.run.median_ms);
-          p95.push_back(j.run.p95_ms);
-          cpu.push_back(j.run.median_cpu_ms);
-        }
-        char line[256];
-        std::snprintf(line, sizeof(line), "| %s | %s | %.4f | %.4f | %d | %.1f | %.1f | %.1f |\n",
-                      r.c_str(), m.c_str(), n_ok > 0 ? std::sqrt(s_ok / n_ok) : NAN,
-                      n_all > 0 ? std::sqrt(s_all / n_all) : NAN, failures,
-                      lioapp::Percentile(med, 0.5), lioapp::Percentile(p95, 0.5),
-                      lioapp::Percentile(cpu, 0.5));
-        md << line;
-        bars.emplace_back(r, m, n_all > 0 ? std::sqrt(s_all / n_all) : NAN);
-      }
-    }
+    const std::string settings = SettingsText(config_path);
+    io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
+    lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
     const double el =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    md << "\nWall time " << el << " s on " << threads << " threads. A failure is a run with a "
-       << "failed scan or an ATE above " << FLAGS_failure_ate << " m.\n";
-    io::WriteTextFile(FLAGS_out + "/table.md", md.str());
-    std::printf("%s", md.str().c_str());
-    WriteBarSvg(FLAGS_out + "/table2.svg", bars, regimes, methods);
+    std::ostringstream provenance;
+    provenance << "Wall time " << el << " s on " << threads << " threads.";
+    WriteTable(FLAGS_out, settings, rows, provenance.str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ctlio_experiment: %s\n", e.what());

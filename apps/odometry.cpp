@@ -6,6 +6,7 @@
 //    --time_field F --time_unit s|ms|us|ns --time_reference relative|absolute --stamp_at
 //    start|end])
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
+//   ctlio_odometry --format sim --sim_imu_dropout 5:1 ...   # no IMU samples in [5 s, 6 s)
 //
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
 // --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
@@ -81,6 +82,9 @@ DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
 DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
 DEFINE_int32(sim_beams, 128, "--format sim: lidar beams");
+DEFINE_string(sim_imu_dropout, "",
+              "--format sim: IMU outages start:length[,start:length...] in seconds since the "
+              "sequence start (samples inside are absent), e.g. 5:1");
 
 namespace {
 
@@ -95,6 +99,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     c.duration_s = FLAGS_sim_duration;
     c.lidar.firing_decimation = FLAGS_sim_firing_decimation;
     c.lidar.beams = FLAGS_sim_beams;
+    c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
     std::ostringstream name;
     name << "sim:" << (FLAGS_sim_world == "box" ? "" : FLAGS_sim_world + "/") << FLAGS_sim_regime
          << "/" << FLAGS_sim_index;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ctlio/factors/gp/vector_prior.h"
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
 #include "ctlio/factors/lidar/point_to_plane_world.h"
 #include "ctlio/manifolds/pose_manifold.h"
@@ -40,7 +41,7 @@ class DeskewedLidarTerm final : public LidarTerm {
 
   size_t num_keypoints() const override { return keypoints_.size(); }
   void BeginRound() override {
-    table_ = estimator_.Integrate(prev_, s_.t);
+    table_ = estimator_.Deskew(prev_, s_);
     T_wb_ = PoseManifold::Pose(s_.pose);
   }
   void Locate(size_t i, Vec3* q, Vec3* p_map) override {
@@ -106,6 +107,45 @@ NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, d
   return table;
 }
 
+NavStateEstimator::DeskewTable NavStateEstimator::Deskew(const State& from, const State& to) const {
+  if (!to.after_gap) return Integrate(from, to.t);
+  DeskewTable table;
+  table.t = {from.t, to.t};
+  table.T_wb = {PoseManifold::Pose(from.pose), PoseManifold::Pose(to.pose)};
+  table.T_end_inv = table.T_wb.back().Inverse();
+  return table;
+}
+
+std::string NavStateEstimator::ImuGapRecovery() const {
+  if (config_.gap_zero_order_hold) return "bridged by holding the last sample";
+  return "not preintegrated: constant-twist prediction, lidar-only registration, velocity random "
+         "walk; the preintegration restarts from the estimate when the IMU returns";
+}
+
+void NavStateEstimator::AddStateAcrossGap(const State& prev, double t_end, SlidingWindow* window) {
+  const double dt = t_end - prev.t;
+  const SE3 T_prev = PoseManifold::Pose(prev.pose);
+  SE3 T_pred = T_prev;
+  Vec3 v = Eigen::Map<const Vec3>(prev.velocity);
+  if (states_.size() >= 2) {
+    // Constant body twist of the last interval, extrapolated (SE(3) constant velocity).
+    const State& before = states_[states_.size() - 2];
+    const Vec6 xi = (PoseManifold::Pose(before.pose).Inverse() * T_prev).Log();
+    T_pred = T_prev * SE3::Exp(xi * (dt / std::max(prev.t - before.t, 1e-6)));
+  } else {
+    T_pred = SE3(T_prev.rotation(), T_prev.translation() + dt * v);
+  }
+  const Vec6 bias = Eigen::Map<const Vec6>(prev.bias);
+  states_.push_back(AddNavState(t_end, T_pred, v, bias, window));
+  State& s = states_.back();
+  s.after_gap = true;
+  // v_s − v_prev ~ N(0, q·Δt·I): VectorGpPrior with Φ = I (a random walk on the velocity).
+  const Mat3 sqrt_info = Mat3::Identity() / std::sqrt(config_.gap_velocity_walk * dt);
+  window->AddResidualBlock(new gp::VectorGpPrior<3>(Mat3::Identity(), sqrt_info), nullptr,
+                           {prev.keys.velocity, s.keys.velocity});
+  window->AddResidualBlock(MakeBiasRandomWalk(config_, dt), nullptr, {prev.keys.bias, s.keys.bias});
+}
+
 SE3 NavStateEstimator::NewestPose() const { return PoseManifold::Pose(states_.back().pose); }
 
 std::vector<SE3> NavStateEstimator::PosesSincePrevious(const std::vector<double>& t) const {
@@ -147,7 +187,13 @@ void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
 void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                  ScanResult* result) {
   const State prev = states_.back();
-  const std::vector<ImuSegment> segments = imu_.Segments(prev.t, scan.t_end, nullptr);
+  double max_gap = 0.0;
+  const std::vector<ImuSegment> segments = imu_.Segments(prev.t, scan.t_end, &max_gap);
+  if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.max_imu_gap)) {
+    AddStateAcrossGap(prev, scan.t_end, window);
+    result->imu_residuals = 0;
+    return;
+  }
   if (segments.empty()) throw std::runtime_error("no IMU samples for this scan");
 
   // Preintegration between the two states, linearised at the previous bias estimate; its
@@ -174,7 +220,7 @@ std::unique_ptr<LidarTerm> NavStateEstimator::MakeLidarTerm(const PreparedScan& 
 
 std::vector<Vec3> NavStateEstimator::MapPoints(const PreparedScan& scan) const {
   const State& s = states_.back();
-  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t);
+  const DeskewTable table = Deskew(states_[states_.size() - 2], s);
   const SE3 T_wb = PoseManifold::Pose(s.pose);
   std::vector<Vec3> map_points;
   map_points.reserve(scan.points.size());

@@ -105,6 +105,7 @@ void OdometryConfig::Validate() const {
   require(gravity_init_duration >= 0 && gravity_init_max_std > 0, "bad init parameters");
   require(min_associations >= 0, "init.min_associations must be >= 0");
   require(max_imu_gap > 0, "init.max_imu_gap must be positive");
+  require(gap_velocity_walk > 0, "imu.gap_velocity_walk must be positive");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(window_knots >= 2, "window.knots must be >= 2");
   require(solver_threads >= 1, "window solver settings must be >= 1");
@@ -139,7 +140,9 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
                    {"exact_specific_force", SetFromYaml(&c.exact_specific_force)},
                    {"input_accel_sigma", SetFromYaml(&c.input_accel_sigma)},
                    {"input_gyro_sigma", SetFromYaml(&c.input_gyro_sigma)},
-                   {"rate_hint", SetFromYaml(&c.imu_rate_hint)}});
+                   {"rate_hint", SetFromYaml(&c.imu_rate_hint)},
+                   {"gap_velocity_walk", SetFromYaml(&c.gap_velocity_walk)},
+                   {"gap_zero_order_hold", SetFromYaml(&c.gap_zero_order_hold)}});
     } else if (key == "init") {
       ReadSection(v, key, source,
                   {{"gravity_duration", SetFromYaml(&c.gravity_init_duration)},

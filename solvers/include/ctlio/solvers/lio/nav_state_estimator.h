@@ -3,6 +3,14 @@
 // consecutive states, and the keypoints deskewed by integrating the IMU from the previous state
 // (re-done every association round) as PointToPlaneWorld residuals at the single pose of the
 // scan end. Same front end, registration and window as Singer-LIO: only the motion model differs.
+//
+// IMU gaps: an interval between two states with a hole in the IMU longer than init.max_imu_gap
+// is not preintegrated (holding the last sample over the hole integrates a stale acceleration
+// into a diverging prediction). The new state is predicted by the constant twist of the last two
+// states, its keypoints are deskewed by the constant twist between the states, and the two
+// states are linked only by a weak velocity random walk (imu.gap_velocity_walk) and the bias
+// random walk: the lidar alone registers the scan. The first interval with the IMU back is
+// preintegrated from the estimated state again (the preintegration is re-anchored).
 #pragma once
 
 #include <deque>
@@ -34,7 +42,7 @@ class NavStateEstimator final : public Estimator {
   SE3 PreviousPose() const override;
   double previous_time() const override { return states_[states_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
-  std::string ImuGapRecovery() const override { return "bridged by holding the last sample"; }
+  std::string ImuGapRecovery() const override;
 
   // A state's blocks live in the window.
   struct State {
@@ -43,6 +51,7 @@ class NavStateEstimator final : public Estimator {
     double* pose = nullptr;      // T_wb = T_mr (body → world = map)
     double* velocity = nullptr;  // world frame, 3
     double* bias = nullptr;      // [b_a; b_g]
+    bool after_gap = false;      // the interval from the previous state is not preintegrated
   };
   // Poses T_wb at the boundaries of the IMU segments over [from.t, t_end], integrated from the
   // current estimate of `from` (pose, velocity, bias); between them a constant twist.
@@ -55,10 +64,15 @@ class NavStateEstimator final : public Estimator {
     Vec3 ToEnd(double tau, const Vec3& q) const { return T_end_inv * (Interpolate(tau) * q); }
   };
   DeskewTable Integrate(const State& from, double t_end) const;
+  // The deskew table of the interval ending at `to` (IMU-integrated, or the constant twist
+  // between the two states across a gap).
+  DeskewTable Deskew(const State& from, const State& to) const;
 
  private:
   State AddNavState(double t, const SE3& T_wb, const Vec3& v, const Vec6& bias,
                     SlidingWindow* window);
+  // Across an IMU gap: the constant-twist prediction and the velocity random walk.
+  void AddStateAcrossGap(const State& prev, double t_end, SlidingWindow* window);
 
   OdometryConfig config_;
   const ImuBuffer& imu_;

@@ -59,6 +59,12 @@ struct OdometryConfig {
   double input_accel_sigma = 0.02;  // m/s², per sample at rate_hint
   double input_gyro_sigma = 0.01;   // rad/s, per sample at rate_hint
   double imu_rate_hint = 200.0;     // Hz, for the densities above
+  // IMU-input baseline across an IMU gap (no preintegration there): the velocity is a random
+  // walk with this variance per second [(m/s)²/s] between the states around the gap.
+  double gap_velocity_walk = 4.0;
+  // The earlier behaviour, kept to measure against: preintegrate across the gap holding the last
+  // sample (zero-order hold).
+  bool gap_zero_order_hold = false;
 
   // (The lidar residual's standard deviation is frontend.point_noise_sigma: the planarity-weighted
   // point-to-plane error is divided by it, and the loss scale stays in metres.)
