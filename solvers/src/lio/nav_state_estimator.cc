@@ -118,7 +118,7 @@ NavStateEstimator::DeskewTable NavStateEstimator::Deskew(const State& from, cons
 
 std::string NavStateEstimator::ImuGapRecovery() const {
   if (config_.gap_zero_order_hold) return "bridged by holding the last sample";
-  return "not preintegrated: constant-twist prediction, lidar-only registration, velocity random "
+  return "held over holes up to imu.gap_hold_max; longer ones not preintegrated: constant-twist prediction, lidar-only registration, velocity random "
          "walk; the preintegration restarts from the estimate when the IMU returns";
 }
 
@@ -189,7 +189,7 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
   const State prev = states_.back();
   double max_gap = 0.0;
   const std::vector<ImuSegment> segments = imu_.Segments(prev.t, scan.t_end, &max_gap);
-  if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.max_imu_gap)) {
+  if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.gap_hold_max)) {
     AddStateAcrossGap(prev, scan.t_end, window);
     result->imu_residuals = 0;
     return;

@@ -106,6 +106,7 @@ void OdometryConfig::Validate() const {
   require(min_associations >= 0, "init.min_associations must be >= 0");
   require(max_imu_gap > 0, "init.max_imu_gap must be positive");
   require(gap_velocity_walk > 0, "imu.gap_velocity_walk must be positive");
+  require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(window_knots >= 2, "window.knots must be >= 2");
   require(solver_threads >= 1, "window solver settings must be >= 1");
@@ -142,6 +143,7 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
                    {"input_gyro_sigma", SetFromYaml(&c.input_gyro_sigma)},
                    {"rate_hint", SetFromYaml(&c.imu_rate_hint)},
                    {"gap_velocity_walk", SetFromYaml(&c.gap_velocity_walk)},
+                   {"gap_hold_max", SetFromYaml(&c.gap_hold_max)},
                    {"gap_zero_order_hold", SetFromYaml(&c.gap_zero_order_hold)}});
     } else if (key == "init") {
       ReadSection(v, key, source,

@@ -62,6 +62,10 @@ struct OdometryConfig {
   // IMU-input baseline across an IMU gap (no preintegration there): the velocity is a random
   // walk with this variance per second [(m/s)²/s] between the states around the gap.
   double gap_velocity_walk = 4.0;
+  // Holes in the IMU up to this length [s] are still preintegrated, holding the last sample (a
+  // few missing samples: the hold's error grows with the square of the hole); only longer holes
+  // switch to the gap mode above, where the hold diverges (README "IMU dropout").
+  double gap_hold_max = 0.1;
   // The earlier behaviour, kept to measure against: preintegrate across the gap holding the last
   // sample (zero-order hold).
   bool gap_zero_order_hold = false;
