@@ -8,6 +8,7 @@
 #include <random>
 
 #include "common/gradient_check.h"
+#include "imu/imu_test_blocks.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/manifolds/rotation_manifold.h"
 
@@ -25,34 +26,8 @@ SingerModel<6> Singer() {
   return SingerModel<6>(qc, alpha);
 }
 
-// Parameter storage for the two knots, the biases and C_mi.
-struct Blocks {
-  double pose_k[7], vel_k[6], acc_k[6], pose_k1[7], vel_k1[6], acc_k1[6], b_k[6], b_k1[6], q_mi[4];
-  Blocks(const KnotState& k, const KnotState& k1, const Vec6& bk, const Vec6& bk1,
-         const Mat3& C_mi) {
-    PoseManifold::Store(k.pose, pose_k);
-    PoseManifold::Store(k1.pose, pose_k1);
-    Eigen::Map<Vec6>{vel_k} = k.velocity;
-    Eigen::Map<Vec6>{acc_k} = k.acceleration;
-    Eigen::Map<Vec6>{vel_k1} = k1.velocity;
-    Eigen::Map<Vec6>{acc_k1} = k1.acceleration;
-    Eigen::Map<Vec6>{b_k} = bk;
-    Eigen::Map<Vec6>{b_k1} = bk1;
-    RotationManifold::Store(C_mi, q_mi);
-  }
-  std::vector<const double*> Gyro() const {
-    return {pose_k, vel_k, acc_k, pose_k1, vel_k1, acc_k1, b_k, b_k1};
-  }
-  std::vector<const double*> Accel() const {
-    return {pose_k, vel_k, acc_k, pose_k1, vel_k1, acc_k1, b_k, b_k1, q_mi};
-  }
-};
-
-Vec3 Evaluate(const ceres::CostFunction& cost, const std::vector<const double*>& params) {
-  Vec3 r;
-  EXPECT_TRUE(cost.Evaluate(params.data(), r.data(), nullptr));
-  return r;
-}
+using ::ctlio::testing::Blocks;
+using ::ctlio::testing::Evaluate;
 
 // Constant body twist: T_rm(t) = Exp(tϖ)T_0, ϖ̇ = 0, so the interpolation
 // between knots on it is exact for every Singer α. The physical IMU reads

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/expect_error.h"
 #include "common/temp_dir.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
@@ -36,15 +37,7 @@ sim::SimConfig SmallSim() {
   return c;
 }
 
-template <typename F>
-void ExpectError(F f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  }
-}
+using ::ctlio::testing::ExpectError;
 
 std::vector<ScanFrame> ReadAll(DataSource& s) {
   std::vector<ScanFrame> out;

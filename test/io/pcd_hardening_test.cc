@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "common/expect_error.h"
 #include "common/temp_dir.h"
 #include "ctlio/io/point_cloud_io.h"
 
@@ -19,15 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-template <typename F>
-void ExpectError(F f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  }
-}
+using ::ctlio::testing::ExpectError;
 
 std::string Write(const fs::path& dir, const std::string& name, const std::string& bytes) {
   const std::string p = (dir / name).string();

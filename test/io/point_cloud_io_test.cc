@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "common/expect_error.h"
 #include "common/temp_dir.h"
 
 namespace ctlio::io {
@@ -35,15 +36,7 @@ PointCloud RandomCloud(size_t n, int64_t stamp) {
 }
 
 // Expect `f` to throw std::runtime_error whose message contains every string of `parts`.
-template <typename F>
-void ExpectError(F f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  }
-}
+using ::ctlio::testing::ExpectError;
 
 TEST(PointCloudIo, PcdRoundTripKeepsOusterFieldsAndTimes) {
   const fs::path d = TempDir("pcd");

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <random>
 
+#include "common/expect_error.h"
 #include "common/temp_dir.h"
 #include "io/time_variants.h"
 
@@ -21,15 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-template <typename F>
-void ExpectError(F f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  }
-}
+using ::ctlio::testing::ExpectError;
 
 // A 0.1 s sweep of `n` points with absolute times starting at a Newer College-like epoch.
 PointCloud Sweep(size_t n, uint32_t seed) {

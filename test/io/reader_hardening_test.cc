@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/expect_error.h"
 #include "common/temp_dir.h"
 #include "ctlio/io/dataset.h"
 #include "ctlio/io/kitti.h"
@@ -21,15 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-template <typename F>
-void ExpectError(F f, const std::vector<std::string>& parts) {
-  try {
-    f();
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    for (const auto& p : parts) EXPECT_THAT(e.what(), HasSubstr(p));
-  }
-}
+using ::ctlio::testing::ExpectError;
 
 sim::SimConfig TinySim() {
   sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 1);
