@@ -3,6 +3,8 @@
 //   ctlio_odometry --dataset DIR --format newer_college|ctlio|kitti
 //                  --method singer_lio|imu_input|lidar_gyro|lidar_only --config FILE --out DIR
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
+//   ctlio_odometry --format sim --sim_preset newer_college --sim_index 0 \
+//                  --config data/newer_college_lio.yaml --out DIR
 //
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
@@ -18,6 +20,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "ctlio/io/kitti.h"
@@ -25,6 +28,7 @@
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
+#include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
 
@@ -36,6 +40,8 @@ DEFINE_string(config, "", "YAML config (data/sim_lio.yaml, data/newer_college_li
 DEFINE_string(out, "", "Output folder (created); with several methods one subfolder per method");
 DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all)");
 DEFINE_bool(progress, true, "Show progress on stderr");
+DEFINE_string(sim_preset, "",
+              "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
@@ -47,17 +53,34 @@ namespace {
 
 using namespace ctlio;
 
+// A --sim_* flag's value when it should apply: always without a preset, only if given
+// explicitly with one (the preset's value stands otherwise).
+template <class T>
+std::optional<T> Given(const char* flag, const T& value) {
+  if (FLAGS_sim_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
+    return value;
+  }
+  return std::nullopt;
+}
+
 std::unique_ptr<io::DataSource> OpenSource() {
   if (FLAGS_format == "sim") {
-    sim::SimConfig c =
-        sim::ExperimentConfig(sim::ParseRegime(FLAGS_sim_regime), FLAGS_sim_index,
-                              sim::kExperimentSeed, sim::ParseWorld(FLAGS_sim_world));
-    c.duration_s = FLAGS_sim_duration;
-    c.lidar.firing_decimation = FLAGS_sim_firing_decimation;
-    c.lidar.beams = FLAGS_sim_beams;
+    const sim::Preset preset = sim::ParsePreset(FLAGS_sim_preset);
+    sim::SimOverrides given;
+    if (auto r = Given("sim_regime", FLAGS_sim_regime)) given.regime = sim::ParseRegime(*r);
+    if (auto w = Given("sim_world", FLAGS_sim_world)) given.world = sim::ParseWorld(*w);
+    given.duration_s = Given("sim_duration", FLAGS_sim_duration);
+    given.firing_decimation = Given("sim_firing_decimation", FLAGS_sim_firing_decimation);
+    given.beams = Given("sim_beams", FLAGS_sim_beams);
+    const sim::SimConfig c =
+        sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
+    const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
     std::ostringstream name;
-    name << "sim:" << (FLAGS_sim_world == "box" ? "" : FLAGS_sim_world + "/") << FLAGS_sim_regime
-         << "/" << FLAGS_sim_index;
+    name << "sim:"
+         << (preset == sim::Preset::kNone ? "" : std::string(sim::PresetName(preset)) + ":")
+         << (world == sim::WorldKind::kBox ? "" : std::string(sim::WorldName(world)) + "/")
+         << sim::RegimeName(given.regime.value_or(sim::PresetRegime(preset))) << "/"
+         << FLAGS_sim_index;
     return std::make_unique<sim::SimulatedSource>(c, name.str());
   }
   if (FLAGS_dataset.empty()) throw std::runtime_error("--dataset is required (or --format sim)");
