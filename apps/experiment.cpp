@@ -199,8 +199,7 @@ int main(int argc, char** argv) {
           const sim::SimConfig c =
               sim::PresetConfig(preset, job.index, sim::kExperimentSeed, job_given);
           sim::SimulatedSource source(c, "sim:" + job.regime + "/" + std::to_string(job.index));
-          lio::OdometryConfig config = base;
-          config.method = lio::ParseLioMethod(job.method);
+          const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(job.method));
           job.run = lioapp::RunOdometry(source, config, {}, FLAGS_failure_ate);
           job.done = true;
         } catch (const std::exception& e) {

@@ -121,8 +121,7 @@ int main(int argc, char** argv) {
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     std::vector<lioapp::RunSummary> runs;
     for (const std::string& m : methods) {
-      lio::OdometryConfig config = base;
-      config.method = lio::ParseLioMethod(m);
+      const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
       auto source = OpenSource();
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
