@@ -1,5 +1,6 @@
 // study_1d: the paper's 1D experiment (Figs. 3–7), IMU as an input versus a measurement of the
-// state, and the three extensions of issue 7 (SPEC §6). Library: apps/study (ctlio_study).
+// state (SPEC §6), and three extensions: a 100 Hz, σ_acc 0.01 IMU, an accelerometer dropout
+// and two asynchronous accelerometers. Library: apps/study (ctlio_study).
 //
 //   ctlio_study_1d --output_dir=study_1d_out        # main study + extras, CSV/JSON + PNG plots
 //   ctlio_study_1d --extras=false --plot=false      # the timed main study only

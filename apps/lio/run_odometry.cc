@@ -94,13 +94,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
-    for (const io::ImuSample& s : frame.imu) {
-      lio::ImuSample x;  // = imu::ImuSample
-      x.t_ns = s.t_ns;
-      x.gyro = s.gyro;
-      x.accel = s.accel;
-      odometry->AddImu(x);
-    }
+    for (const io::ImuSample& s : frame.imu) odometry->AddImu(s);
     lio::LidarScan scan;
     scan.begin_ns = frame.start_ns;
     scan.end_ns = frame.end_ns;

@@ -1,4 +1,4 @@
-// Trajectory evaluation (issue 8): Umeyama recovers a known SE(3)/Sim(3) exactly; ATE of a
+// Trajectory evaluation (SPEC §6 metric): Umeyama recovers a known SE(3)/Sim(3) exactly; ATE of a
 // trajectory against itself under a random rigid transform is 0; known perturbations give the
 // hand-computed ATE and RPE; association within a tolerance.
 #include "ctlio/eval/trajectory_metrics.h"

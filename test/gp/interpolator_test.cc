@@ -1,6 +1,6 @@
 // GpInterpolator / GpExtrapolator (SPEC §2): values (endpoints, prior mean) and every Jacobian
-// against ceres::GradientChecker at large, small and near-switch configurations; plus the
-// derivative of the SE(3) left Jacobian it relies on.
+// against the common numeric Jacobian check at large, small and near-switch configurations.
+// The derivative of the SE(3) left Jacobian it relies on: se3_jacobian_derivative_test.cc.
 #include "ctlio/factors/gp/interpolator.h"
 
 #include <ceres/sized_cost_function.h>
@@ -12,58 +12,14 @@
 #include <random>
 
 #include "common/gradient_check.h"
-#include "ctlio/factors/gp/se3_jacobian_derivative.h"
-#include "gp_test_util.h"
 
 namespace ctlio::gp {
 namespace {
 
-using ctlio::gp::testing::JacobiansMatchNumericScaled;
 using ctlio::testing::PoseParameters;
 using ctlio::testing::RandomPose;
 using ctlio::testing::RandomVec6;
 const PoseManifold kPoseManifold;
-
-// ---- ∂(J(ξ)w)/∂ξ against central differences (Ridders-free: smooth, step 1e-6) ----
-TEST(Se3JacobianDerivativeTest, MatchesNumericDifferentiation) {
-  std::mt19937 rng(7);
-  for (double angle : {0.0, 1e-9, 1e-4, 0.3, 1.0, 1.999, 2.0, 2.001, 2.5, 3.1, 3.14159}) {
-    for (int trial = 0; trial < 3; ++trial) {
-      Vec6 xi = RandomVec6(rng, 2.0);
-      const Vec3 axis = xi.tail<3>().normalized();
-      xi.tail<3>() = angle * axis;
-      const Vec6 w = RandomVec6(rng, 3.0);
-      const Mat6 D = LeftJacobianVectorDerivative(xi, w);
-      Mat6 Dn;
-      const double h = 1e-6;
-      for (int j = 0; j < 6; ++j) {
-        Vec6 e = Vec6::Zero();
-        e[j] = h;
-        Dn.col(j) = (se3::LeftJacobian(xi + e) * w - se3::LeftJacobian(xi - e) * w) / (2 * h);
-      }
-      EXPECT_LE((D - Dn).norm(), 1e-8 * (1.0 + Dn.norm())) << "angle " << angle << "\n"
-                                                           << D << "\n\n"
-                                                           << Dn;
-      const Mat6 Ji = se3::LeftJacobianInverse(xi);
-      const Mat6 Di = LeftJacobianInverseVectorDerivative(xi, Ji, w);
-      for (int j = 0; j < 6; ++j) {
-        Vec6 e = Vec6::Zero();
-        e[j] = h;
-        Dn.col(j) =
-            (se3::LeftJacobianInverse(xi + e) * w - se3::LeftJacobianInverse(xi - e) * w) / (2 * h);
-      }
-      EXPECT_LE((Di - Dn).norm(), 1e-7 * (1.0 + Dn.norm())) << "angle " << angle;
-    }
-  }
-}
-
-TEST(Se3JacobianDerivativeTest, CoefficientSeriesAndClosedFormsAgreeAtSwitch) {
-  const Se3JacobianCoefficients a(std::nextafter(4.0, 0.0)), b(4.0);
-  for (int i = 0; i < 4; ++i) {
-    EXPECT_NEAR(a.c[i], b.c[i], 1e-14 * std::abs(b.c[i]));
-    EXPECT_NEAR(a.dc[i], b.dc[i], 1e-13 * std::abs(b.dc[i]));
-  }
-}
 
 template <int R, typename Derived>
 void StoreEuclidean(const Eigen::MatrixBase<Derived>& J, double* out) {
@@ -236,9 +192,9 @@ TEST(GpInterpolatorTest, JacobiansMatchNumeric) {
       const std::vector<const double*> p{K.p0.data(), K.v0.data(), K.a0.data(),
                                          K.p1.data(), K.v1.data(), K.a1.data()};
       InterpolatedStateCost state_cost(interp, x.pose);
-      EXPECT_TRUE(JacobiansMatchNumericScaled(state_cost, m, p, 1e-8)) << c.name;
+      EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(state_cost, m, p, 1e-8)) << c.name;
       InterpolatedPoseCost pose_cost(interp, x.pose);
-      EXPECT_TRUE(JacobiansMatchNumericScaled(pose_cost, m, p, 1e-8)) << c.name;
+      EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(pose_cost, m, p, 1e-8)) << c.name;
       // Pose() and State() agree.
       SE3 T;
       PoseJacobian Jp0, Jp1;
@@ -261,8 +217,8 @@ TEST(GpExtrapolatorTest, JacobiansMatchNumeric) {
     KnotState x;
     ex.State(K.k, &x, nullptr);
     ExtrapolatedStateCost cost(ex, x.pose);
-    EXPECT_TRUE(JacobiansMatchNumericScaled(cost, {&kPoseManifold, nullptr, nullptr},
-                                            {K.p0.data(), K.v0.data(), K.a0.data()}, 1e-8))
+    EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(
+        cost, {&kPoseManifold, nullptr, nullptr}, {K.p0.data(), K.v0.data(), K.a0.data()}, 1e-8))
         << c.name;
     SE3 T;
     PoseJacobian Jp;
@@ -451,7 +407,8 @@ TEST(GpInterpolatorRowsTest, SelectedRowsMatchNumeric) {
       for (const unsigned mask : RowMasks()) {
         if (mask == kTranslationRows) continue;  // no residual without the rotation part
         SelectedRowsCost cost(interp, x.pose, mask & ~kTranslationRows);
-        EXPECT_TRUE(JacobiansMatchNumericScaled(cost, m, p, 1e-8)) << c.name << " mask " << mask;
+        EXPECT_TRUE(ctlio::testing::JacobiansMatchNumeric(cost, m, p, 1e-8))
+            << c.name << " mask " << mask;
       }
     }
   }

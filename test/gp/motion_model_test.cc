@@ -1,5 +1,6 @@
 // Motion models of SPEC §2: known values, Q against long-double numerical integration over the
-// α × Δt grid of issue 3, positive definiteness, whitening, series/closed-form continuity.
+// α × Δt grid (α from 0 to 1e4, Δt from 1e-5 to 10 s), positive definiteness, whitening,
+// series/closed-form continuity.
 #include "ctlio/factors/gp/motion_model.h"
 
 #include <gtest/gtest.h>
@@ -206,7 +207,7 @@ TEST(SingerModelTest, CovarianceMatchesNumericalIntegrationOnGrid) {
       EXPECT_EQ(W(1, 2), 0.0);
     }
   }
-  // Full precision in fact (measured 3.6e-16): the 1e-9 of the issue is far from binding.
+  // Full precision in fact (measured 3.6e-16): a 1e-9 requirement would be far from binding.
   EXPECT_LE(worst, 1e-13);
   RecordProperty("worst_relative_error", std::to_string(worst));
   std::cout << "worst relative error of Q over the grid: " << worst << "\n";

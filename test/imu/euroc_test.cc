@@ -1,6 +1,8 @@
 // Real data (SPEC §7): EuRoC MAV V1_01_easy, 200 Hz ADIS16448 IMU with the
 // vicon2gt ground truth (20 Hz, with velocity and biases). Skips when the
 // shared data folder is absent.
+#include "ctlio/io/euroc.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +17,10 @@
 
 namespace ctlio::imu {
 namespace {
+
+using io::GroundTruthState;
+using io::ReadEurocImuCsv;
+using io::ReadVicon2gtCsv;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadToDeg = 180.0 / kPi;
@@ -164,7 +170,8 @@ TEST(EurocData, GravityInitializationRecoversRollPitch) {
     EXPECT_NEAR(delta.z(), 0.0, 1e-12);
     EXPECT_LT(std::abs(delta.x() - log_error.x()), 0.02);
     EXPECT_LT(std::abs(delta.y() - log_error.y()), 0.02);
-    // The requirement: roll and pitch (about the world axes) and the tilt within 1°.
+    // Required of a still-start initialisation: roll and pitch (about the world axes) and the
+    // tilt within 1°.
     EXPECT_LT(std::abs(delta.x()), 1.0);
     EXPECT_LT(std::abs(delta.y()), 1.0);
     EXPECT_LT(tilt, 1.0);

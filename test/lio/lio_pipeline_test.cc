@@ -27,14 +27,6 @@ OdometryConfig Config(LioMethod method) {
   return c;
 }
 
-ImuSample ToImu(const io::ImuSample& x) {
-  ImuSample s;
-  s.t_ns = x.t_ns;
-  s.gyro = x.gyro;
-  s.accel = x.accel;
-  return s;
-}
-
 LidarScan ToScan(io::ScanFrame& f) {
   LidarScan s;
   s.begin_ns = f.start_ns;
@@ -122,7 +114,7 @@ TEST(LioPipeline, ImuGapAndDegenerateScanAreReportedAndSurvived) {
       for (const io::ImuSample& s : f.imu) {
         // Drop the IMU over most of scan 5 (a gap of ~0.08 s).
         if (k == 5 && s.t_ns > f.start_ns && s.t_ns < f.end_ns - 5'000'000) continue;
-        odometry->AddImu(ToImu(s));
+        odometry->AddImu(s);
       }
       LidarScan scan = ToScan(f);
       if (k == 8) {  // a scan that sees almost nothing
@@ -170,7 +162,7 @@ TEST(LioPipeline, LeavingKnotsAreMarginalisedIntoAnInformativePrior) {
   io::ScanFrame f;
   int scans = 0;
   while (source.Next(&f)) {
-    for (const auto& x : f.imu) odometry->AddImu(ToImu(x));
+    for (const auto& x : f.imu) odometry->AddImu(x);
     const ScanResult r = odometry->AddScan(ToScan(f));
     ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
     ++scans;

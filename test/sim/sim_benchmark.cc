@@ -1,4 +1,4 @@
-// Simulator speed (issue 8 asks for a 20 s full-resolution sequence in < 30 s on one core).
+// Simulator speed (the target: a 20 s full-resolution sequence in < 30 s on one core).
 // BM_FullSequence generates every scan and IMU sample of fast/00 in memory; BM_Scan one scan;
 // BM_ScanWorld one scan in each world (box, street, corridor, park, indoor).
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// The expectations of issue 7 (SPEC §6) on reduced but sufficient setups: trained
+// The expectations of SPEC §6 (1D study) on reduced but sufficient setups: trained
 // hyperparameters against the paper's, the Q_k calibration formula, consistency (NEES inside the
 // two-sided 95% χ² bounds), unbiasedness, and equal position RMSE of the two estimators.
 #include "ctlio/study/study.h"
@@ -55,7 +55,7 @@ struct PaperFit {
 };
 
 // The default study (400 Hz, σ_acc 0.05, 10 Hz positions σ 0.01, 10 s; default seed and
-// validation sets), the issue's expectations:
+// validation sets), the expectations of SPEC §6:
 // - Q_k, trained on the 3000-trajectory input validation set (Cramér–Rao spread ±2%), within 20%
 //   of the paper's and within 5% of the calibration formula (RESULTS.md derives both formulas);
 // - σ², α from the first 25 validation trajectories (4000 accelerometer samples each pin them

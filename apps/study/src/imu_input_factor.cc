@@ -1,5 +1,7 @@
 #include "ctlio/study/imu_input_factor.h"
 
+#include "ctlio/factors/priors/sqrt_information.h"
+
 namespace ctlio::study {
 
 void ImuInputPreintegration::Integrate(const InputPiece& piece) {
@@ -19,14 +21,13 @@ void ImuInputPreintegration::Integrate(const InputPiece& piece) {
 
 ImuInputFactor::ImuInputFactor(const ImuInputPreintegration& preintegration)
     : pre_(preintegration) {
-  Eigen::LLT<Eigen::Matrix2d> llt(pre_.covariance());
   // A rank-one Σ (one input piece) or a zero Σ cannot whiten the residual.
-  if (llt.info() != Eigen::Success || pre_.covariance().determinant() <= 0.0) {
+  if (!(pre_.covariance().determinant() > 0.0)) {
     throw std::invalid_argument(std::string(__FILE__) +
                                 ": ImuInputFactor: preintegrated covariance is singular (a factor "
                                 "needs >= 2 input pieces with positive variance)");
   }
-  whiten_ = llt.matrixL().solve(Eigen::Matrix2d::Identity());
+  whiten_ = SqrtInformationFromCovariance<2>(pre_.covariance(), "ImuInputFactor covariance");
 }
 
 bool ImuInputFactor::Evaluate(double const* const* x, double* residual, double** jacobians) const {

@@ -1,8 +1,9 @@
 #include "ctlio/factors/imu/bias_factors.h"
 
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <stdexcept>
+
+#include "ctlio/factors/priors/sqrt_information.h"
 
 namespace ctlio::imu {
 
@@ -28,13 +29,8 @@ bool BiasRandomWalk::Evaluate(double const* const* parameters, double* residuals
   return true;
 }
 
-BiasPrior::BiasPrior(const Vec6& mean, const Mat6& covariance) : mean_(mean) {
-  const Eigen::LLT<Mat6> llt(covariance);
-  if (llt.info() != Eigen::Success || !covariance.allFinite()) {
-    throw std::invalid_argument("BiasPrior: covariance is not positive definite");
-  }
-  sqrt_information_ = llt.matrixL().solve(Mat6::Identity());  // SᵀS = Σ⁻¹
-}
+BiasPrior::BiasPrior(const Vec6& mean, const Mat6& covariance)
+    : mean_(mean), sqrt_information_(SqrtInformationFromCovariance<6>(covariance, "BiasPrior")) {}
 
 bool BiasPrior::Evaluate(double const* const* parameters, double* residuals,
                          double** jacobians) const {

@@ -1,9 +1,9 @@
 #include "ctlio/factors/imu/imu_measurement.h"
 
-#include <Eigen/Cholesky>
 #include <stdexcept>
 
 #include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/priors/sqrt_information.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/manifolds/rotation_manifold.h"
 
@@ -26,11 +26,7 @@ void WriteKnotJacobians(const Row3x18& DJ, const double* pose, double* j_pose, d
 }  // namespace
 
 Mat3 SqrtInformation(const Mat3& covariance) {
-  const Eigen::LLT<Mat3> llt(covariance);
-  if (!covariance.allFinite() || llt.info() != Eigen::Success) {
-    throw std::invalid_argument("IMU measurement: covariance is not positive definite");
-  }
-  return llt.matrixL().solve(Mat3::Identity());
+  return SqrtInformationFromCovariance<3>(covariance, "IMU measurement covariance");
 }
 
 ImuGyroMeasurement::ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,

@@ -7,17 +7,8 @@ namespace ctlio::imu {
 
 Mat3 DoubleIntegralJacobian(const Vec3& phi) {
   const double t2 = phi.squaredNorm();
-  const so3::RodriguesCoefficients k(t2);  // k.c = (θ − sinθ)/θ³
-  double e;
-  if (t2 < so3::kSmallAngle * so3::kSmallAngle) {
-    // e = Σ(−1)ⁿθ²ⁿ/(2n+4)!: the closed form cancels like θ⁴/24 near 0.
-    constexpr double ke[] = {
-        1.0 / 24,        -1.0 / 720,         1.0 / 40320,          -1.0 / 3628800,
-        1.0 / 479001600, -1.0 / 87178291200, 1.0 / 20922789888000, -1.0 / 6402373705728000};
-    e = so3::Series(t2, ke);
-  } else {
-    e = (t2 + 2.0 * std::cos(std::sqrt(t2)) - 2.0) / (2.0 * t2 * t2);
-  }
+  const so3::RodriguesCoefficients k(t2);           // k.c = (θ − sinθ)/θ³
+  const double e = so3::RodriguesCoefficientE(t2);  // (θ² + 2cosθ − 2)/(2θ⁴)
   const Mat3 W = so3::Hat(phi);
   return 0.5 * Mat3::Identity() + k.c * W + e * W * W;
 }

@@ -1,8 +1,8 @@
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
 
-#include <Eigen/Cholesky>
 #include <stdexcept>
 
+#include "ctlio/factors/priors/sqrt_information.h"
 #include "ctlio/manifolds/pose_manifold.h"
 
 namespace ctlio::imu {
@@ -13,14 +13,9 @@ PreintegratedImuFactor::PreintegratedImuFactor(const PreintegratedImu& preintegr
   if (!(pim_.delta_t() > 0.0)) {
     throw std::invalid_argument("PreintegratedImuFactor: empty preintegration (Δt = 0)");
   }
-  const Eigen::LLT<Mat9> llt(pim_.covariance());
-  if (llt.info() != Eigen::Success) {
-    throw std::invalid_argument(
-        "PreintegratedImuFactor: preintegrated covariance is not positive definite "
-        "(are the noise densities zero?)");
-  }
-  // S = L⁻¹ gives SᵀS = Σ⁻¹.
-  sqrt_information_ = llt.matrixL().solve(Mat9::Identity());
+  sqrt_information_ = SqrtInformationFromCovariance<9>(
+      pim_.covariance(),
+      "PreintegratedImuFactor: preintegrated covariance (are the noise densities zero?)");
 }
 
 bool PreintegratedImuFactor::Evaluate(double const* const* parameters, double* residuals,

@@ -87,19 +87,16 @@ inline Mat3 LeftJacobianQ(const Vec6& xi) {
   if (t2 < so3::kSmallAngle * so3::kSmallAngle) {
     // c1 = Σ(−1)ⁿθ²ⁿ/(2n+3)!, c2 = Σ(−1)ⁿθ²ⁿ/(2n+4)!, c3 = Σ(−1)ⁿ(n+1)θ²ⁿ/(2n+5)!.
     c1 = so3::RodriguesCoefficients(t2).c;
-    constexpr double k2[] = {
-        1.0 / 24,        -1.0 / 720,         1.0 / 40320,          -1.0 / 3628800,
-        1.0 / 479001600, -1.0 / 87178291200, 1.0 / 20922789888000, -1.0 / 6402373705728000};
     constexpr double k3[] = {
         1.0 / 120,        -2.0 / 5040,          3.0 / 362880,          -4.0 / 39916800,
         5.0 / 6227020800, -6.0 / 1307674368000, 7.0 / 355687428096000, -8.0 / 121645100408832000};
-    c2 = so3::Series(t2, k2);
+    c2 = so3::RodriguesCoefficientE(t2);
     c3 = so3::Series(t2, k3);
   } else {
     const double t = std::sqrt(t2);
     const double s = std::sin(t), c = std::cos(t);
     c1 = (t - s) / (t2 * t);
-    c2 = (t2 + 2.0 * c - 2.0) / (2.0 * t2 * t2);
+    c2 = so3::RodriguesCoefficientE(t2);
     c3 = (2.0 * t - 3.0 * s + t * c) / (2.0 * t2 * t2 * t);
   }
   const Mat3 P = so3::Hat(phi);

@@ -1,7 +1,7 @@
-// The one interface the odometry consumes (issue 8): a sequence of lidar scans with ABSOLUTE
-// int64-ns per-point times (SPEC §1), the IMU samples between consecutive scans, the lidar→IMU
-// extrinsic and optional ground truth. Implemented by every dataset reader (Newer College 2020,
-// ctlio's simulator folder, KITTI) and by the in-memory simulator source (apps/sim).
+// The one interface the odometry consumes (SPEC §6–7 datasets): a sequence of lidar scans with
+// ABSOLUTE int64-ns per-point times (SPEC §1), the IMU samples between consecutive scans, the
+// lidar→IMU extrinsic and optional ground truth. Implemented by every dataset reader (Newer College
+// 2020, ctlio's simulator folder, KITTI) and by the in-memory simulator source (apps/sim).
 #pragma once
 
 #include <cstdint>
@@ -10,18 +10,16 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/factors/imu/imu_data.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/manifolds/types.h"
 
 namespace ctlio::io {
 
-// One IMU sample in the IMU frame: angular rate [rad/s] and specific force [m/s²].
-struct ImuSample {
-  int64_t t_ns = 0;
-  Vec3 gyro = Vec3::Zero();
-  Vec3 accel = Vec3::Zero();
-};
+// One IMU sample in the IMU frame: angular rate [rad/s] and specific force [m/s²]. The same type
+// as the factors' and the odometry's (no conversion anywhere).
+using ImuSample = imu::ImuSample;
 
 // A timestamped pose. In ground truth it is T_world_lidar: the lidar frame's pose in a fixed world
 // frame (maps lidar coordinates into world coordinates, SPEC §1).

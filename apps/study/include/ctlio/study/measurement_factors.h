@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ctlio/factors/priors/sqrt_information.h"
+
 namespace ctlio::study {
 
 // z = x[index] + n, n ~ N(0, σ²): whitened residual e = (x[index] − z)/σ.
@@ -35,20 +37,15 @@ class ScalarMeasurement final : public ceres::SizedCostFunction<1, D> {
   double sigma_;
 };
 
-// x_0 ~ N(mean, P0): e = Lᵀ(x − mean) with L Lᵀ = P0⁻¹, so ‖e‖² = (x − mean)ᵀP0⁻¹(x − mean).
+// x_0 ~ N(mean, P0): e = W(x − mean) with WᵀW = P0⁻¹, so ‖e‖² = (x − mean)ᵀP0⁻¹(x − mean).
 template <int D>
 class InitialStatePrior final : public ceres::SizedCostFunction<D, D> {
  public:
   using Vector = Eigen::Matrix<double, D, 1>;
   using Matrix = Eigen::Matrix<double, D, D>;
-  InitialStatePrior(const Vector& mean, const Matrix& covariance) : mean_(mean) {
-    Eigen::LLT<Matrix> llt(covariance.inverse());
-    if (llt.info() != Eigen::Success) {
-      throw std::invalid_argument(std::string(__FILE__) +
-                                  ": InitialStatePrior: covariance not positive definite");
-    }
-    sqrt_information_ = llt.matrixL().transpose();
-  }
+  InitialStatePrior(const Vector& mean, const Matrix& covariance)
+      : mean_(mean),
+        sqrt_information_(SqrtInformationFromCovariance<D>(covariance, "InitialStatePrior")) {}
   bool Evaluate(double const* const* x, double* residual, double** jacobians) const override {
     Eigen::Map<Vector> r(residual);
     r = sqrt_information_ * (Eigen::Map<const Vector>(x[0]) - mean_);

@@ -58,7 +58,8 @@ struct NavState {
 };
 
 // H(φ) = ∫₀¹(1−α)Exp(αφ)dα = Σₙ (φ^)ⁿ/(n+2)! = ½I + c·φ^ + e·φ^φ^, with
-// c = (θ − sinθ)/θ³ and e = (θ² + 2cosθ − 2)/(2θ⁴) (series near θ = 0).
+// c = (θ − sinθ)/θ³ (so3::RodriguesCoefficients) and e = (θ² + 2cosθ − 2)/(2θ⁴)
+// (so3::RodriguesCoefficientE).
 Mat3 DoubleIntegralJacobian(const Vec3& phi);
 
 class PreintegratedImu {
