@@ -68,8 +68,10 @@ SlidingWindowOptions::SlidingWindowOptions() {
   solver.minimizer_progress_to_stdout = false;
 }
 
-SlidingWindow::SlidingWindow(const SlidingWindowOptions& options) : options_(options) {
+SlidingWindow::SlidingWindow(const SlidingWindowOptions& options)
+    : options_(options), shared_interpolations_(std::make_unique<SharedInterpolationCallback>()) {
   ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = shared_interpolations_.get();
   problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // states hold shared_ptrs
@@ -273,6 +275,9 @@ void SlidingWindow::Linearize(const std::vector<ceres::ResidualBlockId>& residua
   };
   std::map<std::vector<StateId>, Group> groups;
 
+  // The residuals are evaluated here, not by Ceres: run the shared preparation at the current
+  // estimate ourselves (the factors would otherwise interpolate each point on their own).
+  shared_interpolations_->PrepareForEvaluation(true, true);
   std::vector<const double*> parameters;
   std::vector<double*> jacobians;
   std::vector<RowMajorMatrix> ambient;

@@ -14,8 +14,8 @@
 #include "ctlio/factors/lidar/point_to_plane.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/solvers/lio/frontend.h"
-#include "ctlio/solvers/lio/registration.h"
 #include "ctlio/solvers/lio/voxel_map.h"
+#include "sweep_registration.h"
 
 namespace ctlio::lio {
 namespace {
@@ -148,7 +148,7 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   Vec6 qc, alpha;
   qc << 5000, 5000, 5000, 500, 500, 500;
   alpha << 0, 0, 0, 100, 100, 100;
-  const SweepRegistration registration(options, gp::SingerModel<6>(qc, alpha));
+  const gp::SingerModel<6> model(qc, alpha);
   LidarFrontend map_frontend(options);
   map_frontend.UpdateMap(deskewed.points, Vec3::Zero());
   int keypoints = 0;
@@ -157,11 +157,12 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
     const auto kp = frontend.Keypoints(frontend.Preprocess(sweep));
     keypoints = static_cast<int>(kp.size());
     SE3 T;
-    registration.RegisterRigid(map_frontend.map(), kp, &T);
+    sweep::RegisterRigid(map_frontend.map(), options, kp, &T);
     gp::KnotState k, k1;
     k.pose = T;
     k1.pose = T;
-    benchmark::DoNotOptimize(registration.Register(map_frontend.map(), kp, 0.0, t_end, &k, &k1));
+    benchmark::DoNotOptimize(
+        sweep::RegisterContinuous(map_frontend.map(), options, model, kp, 0.0, t_end, &k, &k1));
   }
   state.counters["keypoints"] = keypoints;
   state.counters["points"] = static_cast<double>(sweep.size());

@@ -1,5 +1,7 @@
-// Jacobians of the lidar point-to-plane factors against numeric differentiation (SPEC §4), at
-// random, large-rotation (|φ| near π) and near-identity poses.
+// The single-pose point-to-plane factors (SPEC §4): PointToPlane on a knot pose T_rm and
+// PointToPlaneWorld on a navigation state's T_wb. Residuals against their definition, and
+// Jacobians against numeric differentiation at random, large-rotation (|φ| near π) and
+// near-identity poses.
 #include "ctlio/factors/lidar/point_to_plane.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +9,7 @@
 #include <random>
 
 #include "common/gradient_check.h"
+#include "ctlio/factors/lidar/point_to_plane_world.h"
 
 namespace ctlio {
 namespace {
@@ -56,34 +59,58 @@ TEST(PointToPlane, ZeroOnThePlane) {
   EXPECT_NEAR(r, 0.0, 1e-12);
 }
 
+// Factor = PointToPlane (pose block T_rm) or PointToPlaneWorld (pose block T_wb).
+template <typename Factor>
 void CheckJacobians(double max_angle, uint32_t seed) {
   std::mt19937 rng(seed);
   const PoseManifold manifold;
   for (int trial = 0; trial < 20; ++trial) {
-    const SE3 T_rm = RandomPose(rng, max_angle, 10.0);
-    const PointToPlane cost(RandomAssociation(rng));
-    const auto x = PoseParameters(T_rm);
+    const SE3 T = RandomPose(rng, max_angle, 10.0);
+    const Factor cost(RandomAssociation(rng));
+    const auto x = PoseParameters(T);
     EXPECT_TRUE(JacobiansMatchNumeric(cost, {&manifold}, {x.data()}, 1e-8))
         << "trial " << trial << " max_angle " << max_angle;
   }
 }
 
-TEST(PointToPlane, JacobianRandomRotations) { CheckJacobians(M_PI, 3); }
-
-TEST(PointToPlane, JacobianLargeRotations) {
-  std::mt19937 rng(4);
+template <typename Factor>
+void CheckJacobiansNearPi(uint32_t seed) {
+  std::mt19937 rng(seed);
   const PoseManifold manifold;
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 20; ++trial) {
     const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
-    const SE3 T_rm(so3::Exp((M_PI - 1e-6 * std::abs(u(rng))) * axis), 5.0 * axis.unitOrthogonal());
-    const PointToPlane cost(RandomAssociation(rng));
-    const auto x = PoseParameters(T_rm);
+    const SE3 T(so3::Exp((M_PI - 1e-6 * std::abs(u(rng))) * axis), 5.0 * axis.unitOrthogonal());
+    const Factor cost(RandomAssociation(rng));
+    const auto x = PoseParameters(T);
     EXPECT_TRUE(JacobiansMatchNumeric(cost, {&manifold}, {x.data()}, 1e-8)) << trial;
   }
 }
 
-TEST(PointToPlane, JacobianSmallRotations) { CheckJacobians(1e-7, 5); }
+TEST(PointToPlane, JacobianRandomRotations) { CheckJacobians<PointToPlane>(M_PI, 3); }
+TEST(PointToPlane, JacobianLargeRotations) { CheckJacobiansNearPi<PointToPlane>(4); }
+TEST(PointToPlane, JacobianSmallRotations) { CheckJacobians<PointToPlane>(1e-7, 5); }
+
+// e = w nᵀ(p_ref − T_wb q): the single-pose residual of the pose T_rm = T_wb⁻¹.
+TEST(PointToPlaneWorld, EqualsPointToPlaneOfTheInversePose) {
+  std::mt19937 rng(6);
+  for (int trial = 0; trial < 20; ++trial) {
+    const SE3 T_wb = RandomPose(rng, 3.0, 10.0);
+    const PlaneAssociation m = RandomAssociation(rng);
+    const auto x_wb = PoseParameters(T_wb), x_rm = PoseParameters(T_wb.Inverse());
+    const double* p_wb[] = {x_wb.data()};
+    const double* p_rm[] = {x_rm.data()};
+    double r_world = 0.0, r = 1.0;
+    ASSERT_TRUE(PointToPlaneWorld(m).Evaluate(p_wb, &r_world, nullptr));
+    ASSERT_TRUE(PointToPlane(m).Evaluate(p_rm, &r, nullptr));
+    EXPECT_NEAR(r_world, m.weight * m.plane_normal.dot(m.plane_point - T_wb * m.point_robot), 1e-9);
+    EXPECT_NEAR(r_world, r, 1e-9);
+  }
+}
+
+TEST(PointToPlaneWorld, JacobianRandomRotations) { CheckJacobians<PointToPlaneWorld>(M_PI, 7); }
+TEST(PointToPlaneWorld, JacobianLargeRotations) { CheckJacobiansNearPi<PointToPlaneWorld>(8); }
+TEST(PointToPlaneWorld, JacobianSmallRotations) { CheckJacobians<PointToPlaneWorld>(1e-7, 9); }
 
 }  // namespace
 }  // namespace ctlio

@@ -28,6 +28,11 @@
 //   - residual evaluation failing or returning NaN/Inf at the current estimate: throws
 //     std::runtime_error and leaves the window unchanged.
 //
+// Shared work (SPEC §4: the interpolated pose of one lidar firing, read by all its points) is
+// registered with shared_interpolations(), the problem's ceres::EvaluationCallback; Linearize (and
+// so Marginalize and Covariance) runs the same preparation before it evaluates the residuals
+// itself, outside Ceres' evaluation loop.
+//
 // States may use nullptr (Euclidean), ctlio::PoseManifold or ctlio::RotationManifold; any other
 // manifold is rejected by AddState, because MarginalizationPrior needs the exact derivative of
 // Minus away from x̄ (see marginalization_prior.h).
@@ -45,6 +50,7 @@
 
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/solvers/schur_complement.h"
+#include "ctlio/solvers/shared_interpolation_callback.h"
 
 namespace ctlio {
 
@@ -128,6 +134,10 @@ class SlidingWindow {
                  const std::vector<StateId>& ordering, Eigen::MatrixXd* H,
                  Eigen::VectorXd* b) const;
 
+  // The problem's evaluation callback: register the shared interpolation of every firing that a
+  // residual of this window reads (ContinuousPointToPlane).
+  SharedInterpolationCallback& shared_interpolations() { return *shared_interpolations_; }
+
   SlidingWindowOptions& options() { return options_; }
   // The underlying problem, for what the window does not wrap (e.g. parameter bounds). Adding or
   // removing blocks through it bypasses the window's bookkeeping: do not.
@@ -145,6 +155,7 @@ class SlidingWindow {
   StateBlock& Get(StateId id, int line);
 
   SlidingWindowOptions options_;
+  std::unique_ptr<SharedInterpolationCallback> shared_interpolations_;  // outlives problem_
   std::unique_ptr<ceres::Problem> problem_;
   std::map<StateId, StateBlock> states_;
   std::unordered_map<ceres::ResidualBlockId, std::vector<StateId>> residuals_;

@@ -5,7 +5,9 @@
 //
 // where T_rm(τ) is the GP interpolation of SPEC §2 between knots k and k+1. The interpolation
 // and its Jacobians come from gp::GpInterpolator (the one place that forms a state between
-// knots); this factor only chains de/dδT(τ) (point_to_plane.h) onto the knots:
+// knots) through a SharedPoseInterpolation, which the points of one firing (same τ) share and a
+// window's evaluation callback fills once per evaluation (shared_pose_interpolation.h); this
+// factor only chains de/dδT(τ) (point_to_plane.h) onto the knots:
 //
 //   de/d[δT_k, δϖ_k, δϖ̇_k] = de/dδT(τ) · ∂δT(τ)/∂(knot k)   (1×6 · 6×18), same for k+1.
 //
@@ -22,21 +24,26 @@
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/lidar/point_to_plane.h"
+#include "ctlio/factors/lidar/shared_pose_interpolation.h"
 
 namespace ctlio {
 
 class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6, 7, 6, 6> {
  public:
-  // `interpolator` is built for this point's τ and the knots' times; points that share a time
-  // may share one interpolator (it is immutable).
+  // `pose` interpolates at this point's τ between the knots' times; the points of one firing
+  // share it.
+  ContinuousPointToPlane(std::shared_ptr<const SharedPoseInterpolation> pose,
+                         const PlaneAssociation& association)
+      : pose_(std::move(pose)), m_(association) {}
+  // A residual on its own (nothing shared, the interpolation computed at every evaluation).
   ContinuousPointToPlane(std::shared_ptr<const gp::GpInterpolator> interpolator,
                          const PlaneAssociation& association)
-      : interpolator_(std::move(interpolator)), m_(association) {}
+      : ContinuousPointToPlane(
+            std::make_shared<const SharedPoseInterpolation>(std::move(interpolator)), association) {
+  }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
-    const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
     const bool want_k =
         jacobians != nullptr &&
         (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr);
@@ -45,7 +52,7 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
         (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
     SE3 T_rm_tau;
     gp::PoseJacobian J_k, J_k1;
-    interpolator_->Pose(k, k1, &T_rm_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
+    pose_->Pose(parameters, &T_rm_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
     if (!want_k && !want_k1) {
       residuals[0] = lidar::PointToPlaneError(T_rm_tau, m_, nullptr);
       return true;
@@ -58,7 +65,7 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
   }
 
   const PlaneAssociation& association() const { return m_; }
-  const gp::GpInterpolator& interpolator() const { return *interpolator_; }
+  const SharedPoseInterpolation& pose() const { return *pose_; }
 
  private:
   // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks.
@@ -70,7 +77,7 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
     if (out[2] != nullptr) Row6{out[2]} = J.rightCols<6>();
   }
 
-  std::shared_ptr<const gp::GpInterpolator> interpolator_;
+  std::shared_ptr<const SharedPoseInterpolation> pose_;
   PlaneAssociation m_;
 };
 

@@ -1,0 +1,49 @@
+// The keypoints of a scan as measurements of the GP trajectory between two knots (SPEC §4): one
+// ContinuousPointToPlane per associated keypoint at its own time τ. The points of one firing
+// (same τ) share one SharedPoseInterpolation (its gp::GpInterpolator's Λ, Ω depend on the times
+// only: built once per scan), which the window's evaluation callback fills once per evaluation
+// (SlidingWindow::shared_interpolations()) and the association reads at the current estimate.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/lidar/shared_pose_interpolation.h"
+#include "ctlio/solvers/lio/frontend.h"
+#include "ctlio/solvers/lio/scan_registration.h"
+#include "ctlio/solvers/lio/state_keys.h"
+
+namespace ctlio::lio {
+
+class ContinuousLidarTerm final : public LidarTerm {
+ public:
+  // Knots k (at t_k) and k1 (at t_k1 > t_k) are states of `window`; keypoints in the robot
+  // frame with times in [t_k, t_k1] (a time outside is clamped, never extrapolated). The
+  // keypoints are referenced, not copied. Registers its firings with the window's callback.
+  ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
+                      const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
+                      SlidingWindow* window);
+
+  size_t num_keypoints() const override { return keypoints_.size(); }
+  void BeginRound() override;
+  void Locate(size_t i, Vec3* q, Vec3* p_map) override;
+  ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
+                                     ceres::LossFunction* loss, SlidingWindow* window) override;
+  SE3 NewestPose() const override;  // T_rm of knot k1
+
+  int num_firings() const { return static_cast<int>(firings_.size()); }
+
+ private:
+  const std::vector<TimedPoint>& keypoints_;
+  std::vector<StateId> states_;  // pose, ϖ, ϖ̇ of k, then of k1
+  SharedPoseInterpolation::KnotBlocks blocks_;
+  std::vector<int> firing_;  // keypoint → firing
+  std::vector<std::shared_ptr<SharedPoseInterpolation>> firings_;
+  // Per firing, this round: the map pose at the current estimate (for the association).
+  std::vector<SE3> T_mr_;
+  std::vector<bool> located_;
+};
+
+}  // namespace ctlio::lio

@@ -1,0 +1,66 @@
+// What differs between the LIO pipelines: the states and the motion/IMU factors (SPEC §2–§4,
+// §6). An Estimator only adds states and factors to the odometry's window and reads its
+// estimate; the odometry (lio_odometry.h) owns the window, the IMU buffer, the front end and the
+// registration, and runs the per-scan steps.
+//
+//   GpKnotEstimator   Singer-LIO, lidar_gyro, lidar_only: GP knots, IMU as a measurement
+//   NavStateEstimator the IMU-as-input baseline: navigation states, preintegrated IMU
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ctlio/solvers/lio/frontend.h"
+#include "ctlio/solvers/lio/imu_buffer.h"
+#include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/lio/scan_registration.h"
+#include "ctlio/solvers/sliding_window.h"
+
+namespace ctlio::lio {
+
+// A scan prepared for the estimators: robot-frame points, times in odometry seconds.
+struct PreparedScan {
+  double t_begin = 0.0, t_end = 0.0;
+  int64_t end_ns = 0;
+  std::vector<TimedPoint> points;     // range-gated and subsampled, robot frame, time order
+  std::vector<TimedPoint> keypoints;  // subset used in the residuals, time order
+};
+
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+
+  // The first scan: the first state at the map origin, at rest, held constant where that fixes
+  // the gauge, and the initial bias prior. C_mi from the gravity initialisation.
+  virtual void Initialise(const PreparedScan& scan, const Mat3& C_mi, SlidingWindow* window) = 0;
+  // A new state at the scan end and the factors tying it to the previous one (motion prior,
+  // IMU). Throws if the scan cannot be processed (e.g. no IMU for a pipeline that needs it).
+  virtual void AddState(const PreparedScan& scan, SlidingWindow* window, ScanResult* result) = 0;
+  // The scan's keypoints as a measurement of the newest states (for ScanRegistration).
+  virtual std::unique_ptr<LidarTerm> MakeLidarTerm(const PreparedScan& scan,
+                                                   SlidingWindow* window) const = 0;
+  // Every preprocessed point in the map frame, each moved by the estimated motion at its time.
+  virtual std::vector<Vec3> MapPoints(const PreparedScan& scan) const = 0;
+  // Writes the newest state's estimate (pose, velocity, bias) into the result.
+  virtual void Report(ScanResult* result) const = 0;
+
+  // States in the window, oldest first: their number, the keys of the oldest (to marginalise)
+  // and forgetting it once the window has marginalised it.
+  virtual int num_states() const = 0;
+  virtual std::vector<StateId> OldestKeys() const = 0;
+  virtual void DropOldest() = 0;
+  // Time (odometry seconds) and map pose T_mr of the newest and the previous state.
+  virtual double newest_time() const = 0;
+  virtual SE3 NewestPose() const = 0;
+  virtual SE3 PreviousPose() const = 0;
+
+  // How an IMU gap is bridged (for the scan's status message).
+  virtual std::string ImuGapRecovery() const = 0;
+};
+
+// The estimator of config.method. `imu` is the odometry's buffer (read only).
+std::unique_ptr<Estimator> MakeEstimator(const OdometryConfig& config, const ImuBuffer& imu);
+
+}  // namespace ctlio::lio

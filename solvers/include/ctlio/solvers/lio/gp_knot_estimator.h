@@ -1,0 +1,65 @@
+// The states and factors of Singer-LIO (the paper's method, SPEC §2–§4): one GP knot
+// {T_rm, ϖ, ϖ̇, b} per scan end, the SE(3) Singer prior between knots, the gyro and the
+// accelerometer as measurements of the interpolated state at every IMU time (biases interpolated
+// linearly between knots, gravity C_mi from the initialisation), a bias random walk between
+// knots, and the keypoints as ContinuousPointToPlane residuals (ContinuousLidarTerm). The
+// `lidar_gyro` method drops the accelerometer; `lidar_only` drops the IMU and the biases.
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/solvers/lio/estimator.h"
+#include "ctlio/solvers/lio/state_keys.h"
+
+namespace ctlio::lio {
+
+class GpKnotEstimator final : public Estimator {
+ public:
+  GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& imu);
+
+  void Initialise(const PreparedScan& scan, const Mat3& C_mi, SlidingWindow* window) override;
+  void AddState(const PreparedScan& scan, SlidingWindow* window, ScanResult* result) override;
+  std::unique_ptr<LidarTerm> MakeLidarTerm(const PreparedScan& scan,
+                                           SlidingWindow* window) const override;
+  std::vector<Vec3> MapPoints(const PreparedScan& scan) const override;
+  void Report(ScanResult* result) const override;
+
+  int num_states() const override { return static_cast<int>(knots_.size()); }
+  std::vector<StateId> OldestKeys() const override;
+  void DropOldest() override { knots_.pop_front(); }
+  double newest_time() const override { return knots_.back().t; }
+  SE3 NewestPose() const override;
+  SE3 PreviousPose() const override;
+  std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
+
+ private:
+  // A knot's blocks live in the window (which owns the storage).
+  struct Knot {
+    double t = 0.0;
+    KnotKeys keys;
+    double* pose = nullptr;
+    double* velocity = nullptr;
+    double* acceleration = nullptr;
+    double* bias = nullptr;  // nullptr for lidar_only
+  };
+  bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
+  Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw, const Vec6& bias,
+               SlidingWindow* window);
+  // T_mr(τ) between knots a and b from the current estimates (GP interpolation, SPEC §2).
+  SE3 PoseAt(const Knot& a, const Knot& b, double tau) const;
+  // Gyro and accelerometer samples in (prev.t, k.t] as measurements (SPEC §3).
+  void AddImuMeasurements(const Knot& prev, const Knot& k, const std::vector<ImuSample>& imu,
+                          SlidingWindow* window, ScanResult* result) const;
+
+  OdometryConfig config_;
+  const ImuBuffer& imu_;
+  gp::SingerModel<6> model_;
+  std::deque<Knot> knots_;  // oldest first
+  int64_t next_knot_ = 0;
+};
+
+}  // namespace ctlio::lio

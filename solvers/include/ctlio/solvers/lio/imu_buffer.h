@@ -1,0 +1,55 @@
+// The IMU samples the odometry has received and not yet consumed (SPEC §3, §4): the single entry
+// point for IMU data (AddImu checks order and finiteness), the samples and the zero-order-hold
+// signal over an interval, the longest hole in the stream, and trimming of what is no longer
+// needed. Times are int64 ns at the interface and double seconds relative to the odometry's
+// origin (the first scan's start) inside.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "ctlio/solvers/lio/odometry_config.h"
+
+namespace ctlio::lio {
+
+// One piece of the zero-order-hold IMU signal: sample held constant for dt seconds.
+struct ImuSegment {
+  Vec3 gyro = Vec3::Zero();
+  Vec3 accel = Vec3::Zero();
+  double t_begin = 0.0;  // seconds (odometry time)
+  double dt = 0.0;
+};
+
+class ImuBuffer {
+ public:
+  // Throws std::invalid_argument if the sample is not finite or older than the previous one;
+  // a repeated timestamp is dropped (the first sample is kept) and counted in duplicates().
+  void AddImu(const ImuSample& sample);
+
+  // Odometry time: seconds since origin_ns (set once, at the first scan).
+  void SetOrigin(int64_t origin_ns) { origin_ns_ = origin_ns; }
+  int64_t origin_ns() const { return origin_ns_; }
+  double Seconds(int64_t t_ns) const { return 1e-9 * static_cast<double>(t_ns - origin_ns_); }
+
+  // The zero-order-hold signal over [t_a, t_b] (seconds); the sample in force at t_a is the last
+  // one at or before t_a (or the first one if none). Returns the longest hole between consecutive
+  // samples inside [t_a, t_b] (including the ends) in *max_gap (may be null).
+  std::vector<ImuSegment> Segments(double t_a, double t_b, double* max_gap) const;
+  // The longest hole in the stream over [t_a, t_b], as Segments reports it.
+  double MaxGap(double t_a, double t_b) const;
+  // All samples with t_a < t ≤ t_b.
+  std::vector<ImuSample> Samples(double t_a, double t_b) const;
+  // Drops samples that can no longer be needed (older than t minus one sample).
+  void Trim(double t);
+
+  const std::deque<ImuSample>& samples() const { return samples_; }
+  size_t duplicates() const { return duplicates_; }
+
+ private:
+  std::deque<ImuSample> samples_;
+  size_t duplicates_ = 0;
+  int64_t origin_ns_ = 0;
+};
+
+}  // namespace ctlio::lio

@@ -1,0 +1,68 @@
+// The states and factors of the IMU-as-input baseline (SPEC §3, §4, §6): navigation states
+// {T_wb, v, b} at scan ends, one preintegrated IMU factor (Forster et al. 2017) between
+// consecutive states, and the keypoints deskewed by integrating the IMU from the previous state
+// (re-done every association round) as PointToPlaneWorld residuals at the single pose of the
+// scan end. Same front end, registration and window as Singer-LIO: only the motion model differs.
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ctlio/solvers/lio/estimator.h"
+#include "ctlio/solvers/lio/state_keys.h"
+
+namespace ctlio::lio {
+
+class NavStateEstimator final : public Estimator {
+ public:
+  NavStateEstimator(const OdometryConfig& config, const ImuBuffer& imu);
+
+  void Initialise(const PreparedScan& scan, const Mat3& C_mi, SlidingWindow* window) override;
+  void AddState(const PreparedScan& scan, SlidingWindow* window, ScanResult* result) override;
+  std::unique_ptr<LidarTerm> MakeLidarTerm(const PreparedScan& scan,
+                                           SlidingWindow* window) const override;
+  std::vector<Vec3> MapPoints(const PreparedScan& scan) const override;
+  void Report(ScanResult* result) const override;
+
+  int num_states() const override { return static_cast<int>(states_.size()); }
+  std::vector<StateId> OldestKeys() const override { return states_.front().keys.All(); }
+  void DropOldest() override { states_.pop_front(); }
+  double newest_time() const override { return states_.back().t; }
+  SE3 NewestPose() const override;
+  SE3 PreviousPose() const override;
+  std::string ImuGapRecovery() const override { return "bridged by holding the last sample"; }
+
+  // A state's blocks live in the window.
+  struct State {
+    double t = 0.0;
+    NavStateKeys keys;
+    double* pose = nullptr;      // T_wb = T_mr (body → world = map)
+    double* velocity = nullptr;  // world frame, 3
+    double* bias = nullptr;      // [b_a; b_g]
+  };
+  // Poses T_wb at the boundaries of the IMU segments over [from.t, t_end], integrated from the
+  // current estimate of `from` (pose, velocity, bias); between them a constant twist.
+  struct DeskewTable {
+    std::vector<double> t;
+    std::vector<SE3> T_wb;
+    SE3 T_end_inv;  // T_wb.back()⁻¹
+    SE3 Interpolate(double tau) const;
+    // q (robot frame at τ) moved into the body frame at the table's end.
+    Vec3 ToEnd(double tau, const Vec3& q) const { return T_end_inv * (Interpolate(tau) * q); }
+  };
+  DeskewTable Integrate(const State& from, double t_end) const;
+
+ private:
+  State AddNavState(double t, const SE3& T_wb, const Vec3& v, const Vec6& bias,
+                    SlidingWindow* window);
+
+  OdometryConfig config_;
+  const ImuBuffer& imu_;
+  Vec3 gravity_map_ = Vec3::Zero();
+  std::deque<State> states_;  // oldest first
+  int64_t next_state_ = 0;
+};
+
+}  // namespace ctlio::lio

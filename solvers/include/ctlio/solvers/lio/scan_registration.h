@@ -1,0 +1,76 @@
+// Registration of one scan's keypoints against the voxel map (SPEC §4), the one loop every LIO
+// pipeline (and any user of the window) runs:
+//
+//   for each round (≤ max_iterations):
+//     associate  every keypoint, placed in the map by the current estimate, with a plane of the
+//                map (PlaneAssociator) and add its point-to-plane residual to the window;
+//                fewer than min_associations: degenerate scan, the lidar term is dropped;
+//     solve      the window (solver_iterations Levenberg–Marquardt steps);
+//     converged? the newest pose moved less than convergence_translation/_rotation.
+//
+// Where a keypoint lands in the map and which factor it gets depend on the state
+// parametrisation; a LidarTerm supplies both (the GP knots' ContinuousPointToPlane, the
+// navigation states' deskewed PointToPlaneWorld). The residuals of the last round stay in the
+// window, so marginalisation keeps their information.
+#pragma once
+
+#include <ceres/loss_function.h>
+
+#include <memory>
+
+#include "ctlio/factors/lidar/point_to_plane.h"
+#include "ctlio/manifolds/se3.h"
+#include "ctlio/solvers/lio/lidar_frontend_options.h"
+#include "ctlio/solvers/lio/voxel_map.h"
+#include "ctlio/solvers/sliding_window.h"
+
+namespace ctlio::lio {
+
+// The keypoints of one scan as a measurement of the window's states.
+class LidarTerm {
+ public:
+  virtual ~LidarTerm() = default;
+  virtual size_t num_keypoints() const = 0;
+  // Called before each association round: the estimate may have changed since the last one.
+  virtual void BeginRound() {}
+  // Keypoint i at the current estimate: q, the point in the frame its factor transforms, and
+  // p_map, where that puts it in the map.
+  virtual void Locate(size_t i, Vec3* q, Vec3* p_map) = 0;
+  // Adds keypoint i's residual on the associated plane (weight already whitened) to the window.
+  virtual ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
+                                             ceres::LossFunction* loss, SlidingWindow* window) = 0;
+  // The pose whose change between rounds decides convergence (the newest state's).
+  virtual SE3 NewestPose() const = 0;
+};
+
+struct RegistrationSummary {
+  int rounds = 0;             // association rounds run
+  int solver_iterations = 0;  // Levenberg–Marquardt iterations, all rounds
+  int associations = 0;       // residuals added in the last round
+  double initial_cost = 0.0;  // Ceres cost at the start of the first round
+  double final_cost = 0.0;    // Ceres cost after the last round
+  bool converged = false;     // stopped because the newest pose moved less than the thresholds
+  bool degenerate = false;    // too few associations: the lidar term was dropped
+  double ms_associate = 0.0;  // wall time of the association, all rounds
+  double ms_solve = 0.0;      // wall time of the solves, all rounds
+};
+
+// The robust loss of the point-to-plane residuals (cauchy/huber/none, SPEC §4): the residuals
+// are whitened by point_noise_sigma, so the scale, given in metres, is whitened too. nullptr for
+// "none".
+std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& options);
+
+class ScanRegistration {
+ public:
+  ScanRegistration(const LidarFrontendOptions& options, int min_associations);
+
+  RegistrationSummary Register(const VoxelMap& map, LidarTerm* term, SlidingWindow* window) const;
+
+  const LidarFrontendOptions& options() const { return options_; }
+
+ private:
+  LidarFrontendOptions options_;
+  int min_associations_;
+};
+
+}  // namespace ctlio::lio

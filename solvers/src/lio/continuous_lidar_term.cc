@@ -1,0 +1,62 @@
+#include "ctlio/solvers/lio/continuous_lidar_term.h"
+
+#include <algorithm>
+#include <map>
+
+#include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/manifolds/pose_manifold.h"
+
+namespace ctlio::lio {
+
+ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                                         const KnotKeys& k, const KnotKeys& k1,
+                                         const std::vector<TimedPoint>& keypoints,
+                                         SlidingWindow* window)
+    : keypoints_(keypoints), states_(KnotPair(k, k1)) {
+  for (int b = 0; b < 6; ++b) blocks_[b] = window->State(states_[b]);
+  firing_.resize(keypoints.size());
+  std::map<double, int> by_time;
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const double tau = std::clamp(keypoints[i].time, t_k, t_k1);
+    const auto [it, inserted] = by_time.try_emplace(tau, static_cast<int>(firings_.size()));
+    if (inserted) {
+      firings_.push_back(std::make_shared<SharedPoseInterpolation>(
+          std::make_shared<const gp::GpInterpolator>(model, t_k, t_k1, tau), blocks_));
+      window->shared_interpolations().Add(firings_.back());
+    }
+    firing_[i] = it->second;
+  }
+}
+
+void ContinuousLidarTerm::BeginRound() {
+  T_mr_.assign(firings_.size(), SE3());
+  located_.assign(firings_.size(), false);
+  // Until a residual of this round reads it, the callback need not prepare a firing.
+  for (const auto& f : firings_) f->set_active(false);
+}
+
+void ContinuousLidarTerm::Locate(size_t i, Vec3* q, Vec3* p_map) {
+  const int f = firing_[i];
+  if (!located_[f]) {
+    // The interpolation at the current estimate, which the solve then starts from.
+    firings_[f]->Prepare();
+    T_mr_[f] = firings_[f]->pose().Inverse();
+    located_[f] = true;
+  }
+  *q = keypoints_[i].point;
+  *p_map = T_mr_[f] * keypoints_[i].point;
+}
+
+ceres::ResidualBlockId ContinuousLidarTerm::AddResidual(size_t i,
+                                                        const PlaneAssociation& association,
+                                                        ceres::LossFunction* loss,
+                                                        SlidingWindow* window) {
+  const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
+  firing->set_active(true);
+  return window->AddResidualBlock(new ContinuousPointToPlane(firing, association), loss, states_);
+}
+
+SE3 ContinuousLidarTerm::NewestPose() const { return PoseManifold::Pose(blocks_[3]); }
+
+}  // namespace ctlio::lio

@@ -1,0 +1,174 @@
+#include "ctlio/solvers/lio/gp_knot_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/singer_prior.h"
+#include "ctlio/factors/imu/imu_measurement.h"
+#include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/solvers/lio/bias_priors.h"
+#include "ctlio/solvers/lio/continuous_lidar_term.h"
+
+namespace ctlio::lio {
+
+GpKnotEstimator::GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& imu)
+    : config_(config), imu_(imu), model_(config.qc, config.alpha) {}
+
+GpKnotEstimator::Knot GpKnotEstimator::AddKnot(double t, const SE3& T_rm, const Vec6& w,
+                                               const Vec6& dw, const Vec6& bias,
+                                               SlidingWindow* window) {
+  Knot k;
+  k.t = t;
+  k.keys = KnotKeys::ForKnot(next_knot_++);
+  k.pose = window->AddPoseState(k.keys.pose, T_rm);
+  k.velocity = window->AddVectorState(k.keys.velocity, w);
+  k.acceleration = window->AddVectorState(k.keys.acceleration, dw);
+  if (uses_imu()) k.bias = window->AddVectorState(k.keys.bias, bias);
+  return k;
+}
+
+std::vector<StateId> GpKnotEstimator::OldestKeys() const {
+  const Knot& k = knots_.front();
+  std::vector<StateId> keys = k.keys.Motion();
+  if (k.bias != nullptr) keys.push_back(k.keys.bias);
+  return keys;
+}
+
+SE3 GpKnotEstimator::PoseAt(const Knot& a, const Knot& b, double tau) const {
+  const gp::GpInterpolator interp(model_, a.t, b.t, std::clamp(tau, a.t, b.t));
+  SE3 T_rm;
+  interp.Pose(gp::ReadKnotState(a.pose, a.velocity, a.acceleration),
+              gp::ReadKnotState(b.pose, b.velocity, b.acceleration), &T_rm, nullptr, nullptr);
+  return T_rm.Inverse();
+}
+
+SE3 GpKnotEstimator::NewestPose() const { return PoseManifold::Pose(knots_.back().pose).Inverse(); }
+
+SE3 GpKnotEstimator::PreviousPose() const {
+  return PoseManifold::Pose(knots_[knots_.size() - 2].pose).Inverse();
+}
+
+void GpKnotEstimator::Report(ScanResult* result) const {
+  const Knot& k = knots_.back();
+  result->T_mr = PoseManifold::Pose(k.pose).Inverse();
+  // ϖ is minus the body twist [v; ω] in the robot frame (SPEC §1).
+  result->velocity = -Eigen::Map<const Vec6>(k.velocity);
+  result->bias = k.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(k.bias)) : Vec6::Zero();
+}
+
+void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
+                                 SlidingWindow* window) {
+  // Still at start (checked by the gravity initialisation): knot 0 is the map origin at rest.
+  // Its pose, ϖ and ϖ̇ are held constant, which fixes the gauge; its biases are free under the
+  // initial bias prior (zero mean, config variances), so the marginal priors carry them on.
+  if (config_.method == LioMethod::kSingerLio) {
+    window->AddRotationState(kGravityKey, C_mi);
+    if (!config_.estimate_gravity) window->SetStateConstant(kGravityKey, true);
+  }
+  knots_.push_back(AddKnot(scan.t_end, SE3(), Vec6::Zero(), Vec6::Zero(), Vec6::Zero(), window));
+  const Knot& k = knots_.back();
+  for (StateId key : k.keys.Motion()) window->SetStateConstant(key, true);
+  if (uses_imu()) window->AddResidualBlock(MakeInitialBiasPrior(config_), nullptr, {k.keys.bias});
+}
+
+void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
+                               ScanResult* result) {
+  const Knot prev = knots_.back();
+  const double dt = scan.t_end - prev.t;
+  const std::vector<ImuSample> imu =
+      uses_imu() ? imu_.Samples(prev.t, scan.t_end) : std::vector<ImuSample>();
+
+  // Initial guess: constant body velocity from the previous knot; with a gyro, its newest
+  // sample gives the angular part (ϖ_φ = −(ω_meas − b_g), SPEC §1).
+  Vec6 w = Eigen::Map<const Vec6>(prev.velocity);
+  if (uses_imu() && !imu.empty()) {
+    w.tail<3>() = -(imu.back().gyro - Eigen::Map<const Vec3>(prev.bias + 3));
+  }
+  const Vec6 bias = prev.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(prev.bias)) : Vec6::Zero();
+  knots_.push_back(AddKnot(scan.t_end, SE3::Exp(dt * w) * PoseManifold::Pose(prev.pose), w,
+                           Vec6::Zero(), bias, window));
+  const Knot& k = knots_.back();
+
+  // GP prior between the knots (SPEC §2).
+  window->AddResidualBlock(new gp::SingerPrior(model_, dt), nullptr, KnotPair(prev.keys, k.keys));
+  if (uses_imu()) {
+    window->AddResidualBlock(MakeBiasRandomWalk(config_, dt), nullptr,
+                             {prev.keys.bias, k.keys.bias});
+    AddImuMeasurements(prev, k, imu, window, result);
+  }
+}
+
+void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k,
+                                         const std::vector<ImuSample>& imu, SlidingWindow* window,
+                                         ScanResult* result) const {
+  const Mat3 gyro_cov = config_.gyro_variance * Mat3::Identity();
+  const Mat3 accel_cov = config_.accel_variance * Mat3::Identity();
+  const imu::AccelModel accel_model = config_.exact_specific_force ? imu::AccelModel::kSpecificForce
+                                                                   : imu::AccelModel::kBodyCentric;
+  std::vector<StateId> gyro_states = KnotPair(prev.keys, k.keys);
+  gyro_states.push_back(prev.keys.bias);
+  gyro_states.push_back(k.keys.bias);
+  std::vector<StateId> accel_states = gyro_states;
+  accel_states.push_back(kGravityKey);
+  // One loss per scan, shared by its accelerometer residuals (the window ref-counts it).
+  std::unique_ptr<ceres::LossFunction> accel_loss(
+      config_.accel_loss_scale > 0 ? new ceres::CauchyLoss(config_.accel_loss_scale) : nullptr);
+  bool accel_loss_used = false;
+  for (const ImuSample& s : imu) {
+    const double tau = imu_.Seconds(s.t_ns);
+    window->AddResidualBlock(
+        new imu::ImuGyroMeasurement(model_, prev.t, k.t, tau, s.gyro, gyro_cov), nullptr,
+        gyro_states);
+    ++result->imu_residuals;
+    if (config_.method == LioMethod::kSingerLio) {
+      window->AddResidualBlock(
+          new imu::ImuAccelMeasurement(model_, prev.t, k.t, tau, s.accel, accel_cov,
+                                       config_.gravity, accel_model),
+          accel_loss.get(), accel_states);
+      accel_loss_used = accel_loss != nullptr;
+      ++result->imu_residuals;
+    }
+  }
+  if (accel_loss_used) accel_loss.release();
+}
+
+std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& scan,
+                                                          SlidingWindow* window) const {
+  const Knot& prev = knots_[knots_.size() - 2];
+  const Knot& k = knots_.back();
+  return std::make_unique<ContinuousLidarTerm>(model_, prev.t, k.t, prev.keys, k.keys,
+                                               scan.keypoints, window);
+}
+
+std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
+  const Knot& prev = knots_[knots_.size() - 2];
+  const Knot& k = knots_.back();
+  // The GP pose on a 1 ms grid over the interval, and between grid nodes the constant twist of
+  // the node pair (geodesic interpolation): the deviation from the GP mean is
+  // ~½·|ω̇|·(0.5 ms)², 1.3e-5 rad at 100 rad/s² (0.6 mm at 50 m), while the 1 800 firings of a
+  // sweep no longer each need their own GP interpolator.
+  const int nodes = std::max(2, static_cast<int>(std::ceil((k.t - prev.t) / 1e-3)) + 1);
+  const double step = (k.t - prev.t) / (nodes - 1);
+  std::vector<SE3> grid(nodes);
+  std::vector<Vec6> twist(nodes - 1);
+  for (int j = 0; j < nodes; ++j) grid[j] = PoseAt(prev, k, prev.t + j * step);
+  for (int j = 0; j + 1 < nodes; ++j) twist[j] = (grid[j + 1] * grid[j].Inverse()).Log();
+  std::vector<Vec3> map_points;
+  map_points.reserve(scan.points.size());
+  double last_tau = -1.0;
+  SE3 T_mr_tau;
+  for (const TimedPoint& p : scan.points) {
+    if (p.time != last_tau) {  // points of one firing share the pose
+      const double u = std::clamp((p.time - prev.t) / step, 0.0, nodes - 1.0);
+      const int j = std::min(static_cast<int>(u), nodes - 2);
+      T_mr_tau = SE3::Exp((u - j) * twist[j]) * grid[j];
+      last_tau = p.time;
+    }
+    map_points.push_back(T_mr_tau * p.point);
+  }
+  return map_points;
+}
+
+}  // namespace ctlio::lio

@@ -1,0 +1,36 @@
+#include "ctlio/solvers/lio/gravity_alignment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <vector>
+
+#include "ctlio/factors/imu/gravity_initialization.h"
+
+namespace ctlio::lio {
+
+bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig& config, Mat3* C_mi,
+                       std::string* message) {
+  const std::vector<ImuSample> samples(imu.samples().begin(), imu.samples().end());
+  if (samples.empty()) {
+    *message = "gravity initialisation: no IMU samples before the first scan end";
+    return false;
+  }
+  const int64_t end_ns = imu.origin_ns() + static_cast<int64_t>(std::llround(t_end * 1e9));
+  const int64_t t0_ns =
+      std::max(samples.front().t_ns,
+               end_ns - static_cast<int64_t>(std::llround(config.gravity_init_duration * 1e9)));
+  imu::GravityInitializationOptions options;
+  options.gravity = config.gravity;
+  options.max_block_accel_deviation = config.gravity_init_max_std;
+  options.min_samples = 10;
+  try {
+    *C_mi = imu::InitializeGravity(samples, t0_ns, end_ns - t0_ns + 1, options).C_mi;
+  } catch (const std::exception& e) {
+    *message = std::string("gravity initialisation failed: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace ctlio::lio

@@ -1,0 +1,88 @@
+#include "ctlio/solvers/lio/imu_buffer.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace ctlio::lio {
+
+void ImuBuffer::AddImu(const ImuSample& s) {
+  if (!s.gyro.allFinite() || !s.accel.allFinite()) {
+    throw std::invalid_argument(
+        "LioOdometry::AddImu: non-finite IMU sample at t = " + std::to_string(s.t_ns) + " ns");
+  }
+  if (!samples_.empty()) {
+    if (s.t_ns == samples_.back().t_ns) {
+      ++duplicates_;  // documented recovery: keep the first of two equal stamps
+      return;
+    }
+    if (s.t_ns < samples_.back().t_ns) {
+      throw std::invalid_argument("LioOdometry::AddImu: IMU time goes backwards (" +
+                                  std::to_string(s.t_ns) + " ns after " +
+                                  std::to_string(samples_.back().t_ns) + " ns)");
+    }
+  }
+  samples_.push_back(s);
+}
+
+std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap) const {
+  const std::deque<ImuSample>& imu = samples_;
+  std::vector<ImuSegment> out;
+  double gap = 0.0;
+  if (imu.empty() || t_b <= t_a) {
+    if (max_gap) *max_gap = imu.empty() ? t_b - t_a : 0.0;
+    return out;
+  }
+  // Index of the last sample at or before t_a (or the first sample).
+  size_t i = 0;
+  while (i + 1 < imu.size() && Seconds(imu[i + 1].t_ns) <= t_a) ++i;
+  double t = t_a;
+  double last_sample_time = std::min(Seconds(imu[i].t_ns), t_a);
+  const auto hold = [&](double from, double to) {
+    ImuSegment seg;
+    seg.gyro = imu[i].gyro;
+    seg.accel = imu[i].accel;
+    seg.t_begin = from;
+    seg.dt = to - from;
+    out.push_back(seg);
+  };
+  while (t < t_b) {
+    const double t_next = (i + 1 < imu.size()) ? std::min(Seconds(imu[i + 1].t_ns), t_b) : t_b;
+    if (t_next > t) hold(t, t_next);
+    if (i + 1 < imu.size() && Seconds(imu[i + 1].t_ns) <= t_b) {
+      gap = std::max(gap, Seconds(imu[i + 1].t_ns) - last_sample_time);
+      last_sample_time = Seconds(imu[i + 1].t_ns);
+      ++i;
+    }
+    t = t_next;
+    if (i + 1 >= imu.size()) {
+      // No sample after this one: hold it to t_b (an IMU gap at the end of the stream).
+      if (t < t_b) hold(t, t_b);
+      break;
+    }
+  }
+  gap = std::max(gap, t_b - last_sample_time);
+  if (max_gap) *max_gap = gap;
+  return out;
+}
+
+double ImuBuffer::MaxGap(double t_a, double t_b) const {
+  double gap = 0.0;
+  Segments(t_a, t_b, &gap);
+  return gap;
+}
+
+std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b) const {
+  std::vector<ImuSample> out;
+  for (const ImuSample& s : samples_) {
+    const double t = Seconds(s.t_ns);
+    if (t > t_a && t <= t_b) out.push_back(s);
+  }
+  return out;
+}
+
+void ImuBuffer::Trim(double t) {
+  while (samples_.size() > 1 && Seconds(samples_[1].t_ns) <= t) samples_.pop_front();
+}
+
+}  // namespace ctlio::lio

@@ -1,0 +1,175 @@
+#include "ctlio/solvers/lio/nav_state_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "ctlio/factors/imu/preintegrated_imu_factor.h"
+#include "ctlio/factors/lidar/point_to_plane_world.h"
+#include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/solvers/lio/bias_priors.h"
+
+namespace ctlio::lio {
+
+namespace {
+
+// Continuous noise densities σ/√rate of the per-sample standard deviations (SPEC §6).
+imu::ImuNoise InputNoise(const OdometryConfig& config) {
+  imu::ImuNoise noise;
+  noise.gyro_noise_density = config.input_gyro_sigma / std::sqrt(config.imu_rate_hint);
+  noise.accel_noise_density = config.input_accel_sigma / std::sqrt(config.imu_rate_hint);
+  return noise;
+}
+
+imu::NavState ReadNavState(const NavStateEstimator::State& s) {
+  imu::NavState x;
+  const SE3 T = PoseManifold::Pose(s.pose);
+  x.C = T.rotation();
+  x.p = T.translation();
+  x.v = Eigen::Map<const Vec3>(s.velocity);
+  return x;
+}
+
+// The keypoints deskewed into the body frame at the scan end by the IMU integrated from the
+// previous state's current estimate (re-integrated every round), at the single pose T_wb.
+class DeskewedLidarTerm final : public LidarTerm {
+ public:
+  DeskewedLidarTerm(const NavStateEstimator& estimator, const NavStateEstimator::State& prev,
+                    const NavStateEstimator::State& s, const std::vector<TimedPoint>& keypoints)
+      : estimator_(estimator), prev_(prev), s_(s), keypoints_(keypoints) {}
+
+  size_t num_keypoints() const override { return keypoints_.size(); }
+  void BeginRound() override {
+    table_ = estimator_.Integrate(prev_, s_.t);
+    T_wb_ = PoseManifold::Pose(s_.pose);
+  }
+  void Locate(size_t i, Vec3* q, Vec3* p_map) override {
+    *q = table_.ToEnd(keypoints_[i].time, keypoints_[i].point);
+    *p_map = T_wb_ * *q;
+  }
+  ceres::ResidualBlockId AddResidual(size_t, const PlaneAssociation& association,
+                                     ceres::LossFunction* loss, SlidingWindow* window) override {
+    return window->AddResidualBlock(new PointToPlaneWorld(association), loss, {s_.keys.pose});
+  }
+  SE3 NewestPose() const override { return PoseManifold::Pose(s_.pose); }
+
+ private:
+  const NavStateEstimator& estimator_;
+  NavStateEstimator::State prev_, s_;
+  const std::vector<TimedPoint>& keypoints_;
+  NavStateEstimator::DeskewTable table_;
+  SE3 T_wb_;
+};
+
+}  // namespace
+
+SE3 NavStateEstimator::DeskewTable::Interpolate(double tau) const {
+  if (t.empty()) return SE3();
+  if (tau <= t.front()) return T_wb.front();
+  if (tau >= t.back()) return T_wb.back();
+  const size_t j = std::upper_bound(t.begin(), t.end(), tau) - t.begin();
+  const size_t i = j - 1;
+  const double s = (tau - t[i]) / std::max(t[j] - t[i], 1e-12);
+  // Within one IMU period the motion is a constant twist: interpolate on the group.
+  const Vec6 xi = (T_wb[j] * T_wb[i].Inverse()).Log();
+  return SE3::Exp(s * xi) * T_wb[i];
+}
+
+NavStateEstimator::NavStateEstimator(const OdometryConfig& config, const ImuBuffer& imu)
+    : config_(config), imu_(imu) {}
+
+NavStateEstimator::State NavStateEstimator::AddNavState(double t, const SE3& T_wb, const Vec3& v,
+                                                        const Vec6& bias, SlidingWindow* window) {
+  State s;
+  s.t = t;
+  s.keys = NavStateKeys::ForState(next_state_++);
+  s.pose = window->AddPoseState(s.keys.pose, T_wb);
+  s.velocity = window->AddVectorState(s.keys.velocity, v);
+  s.bias = window->AddVectorState(s.keys.bias, bias);
+  return s;
+}
+
+NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end) const {
+  DeskewTable table;
+  const Vec6 bias = Eigen::Map<const Vec6>(from.bias);
+  imu::PreintegratedImu pim(bias, InputNoise(config_));
+  const imu::NavState start = ReadNavState(from);
+  table.t.push_back(from.t);
+  table.T_wb.push_back(PoseManifold::Pose(from.pose));
+  for (const ImuSegment& seg : imu_.Segments(from.t, t_end, nullptr)) {
+    pim.Integrate(seg.accel, seg.gyro, seg.dt);
+    const imu::NavState x = pim.Predict(start, bias, gravity_map_);
+    table.t.push_back(seg.t_begin + seg.dt);
+    table.T_wb.push_back(SE3(x.C, x.p));
+  }
+  table.T_end_inv = table.T_wb.back().Inverse();
+  return table;
+}
+
+SE3 NavStateEstimator::NewestPose() const { return PoseManifold::Pose(states_.back().pose); }
+
+SE3 NavStateEstimator::PreviousPose() const {
+  return PoseManifold::Pose(states_[states_.size() - 2].pose);
+}
+
+void NavStateEstimator::Report(ScanResult* result) const {
+  const State& s = states_.back();
+  const SE3 T_wb = PoseManifold::Pose(s.pose);
+  result->T_mr = T_wb;
+  result->velocity.head<3>() = T_wb.rotation().transpose() * Eigen::Map<const Vec3>(s.velocity);
+  result->velocity.tail<3>().setZero();
+  result->bias = Eigen::Map<const Vec6>(s.bias);
+}
+
+void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
+                                   SlidingWindow* window) {
+  // The platform is still at start (gravity initialisation checked it): the first state is the
+  // map origin at rest, held constant (which fixes the gauge); its biases are free under the
+  // initial bias prior, as in Singer-LIO.
+  gravity_map_ = C_mi * Vec3(0, 0, -config_.gravity);
+  states_.push_back(AddNavState(scan.t_end, SE3(), Vec3::Zero(), Vec6::Zero(), window));
+  const State& s = states_.back();
+  window->SetStateConstant(s.keys.pose, true);
+  window->SetStateConstant(s.keys.velocity, true);
+  window->AddResidualBlock(MakeInitialBiasPrior(config_), nullptr, {s.keys.bias});
+}
+
+void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
+                                 ScanResult* result) {
+  const State prev = states_.back();
+  const std::vector<ImuSegment> segments = imu_.Segments(prev.t, scan.t_end, nullptr);
+  if (segments.empty()) throw std::runtime_error("no IMU samples for this scan");
+
+  // Preintegration between the two states, linearised at the previous bias estimate; its
+  // prediction is the initial guess.
+  const Vec6 bias_hat = Eigen::Map<const Vec6>(prev.bias);
+  imu::PreintegratedImu pim(bias_hat, InputNoise(config_));
+  for (const ImuSegment& seg : segments) pim.Integrate(seg.accel, seg.gyro, seg.dt);
+  const imu::NavState pred = pim.Predict(ReadNavState(prev), bias_hat, gravity_map_);
+  states_.push_back(AddNavState(scan.t_end, SE3(pred.C, pred.p), pred.v, bias_hat, window));
+  const State& s = states_.back();
+  window->AddResidualBlock(
+      new imu::PreintegratedImuFactor(pim, gravity_map_), nullptr,
+      {prev.keys.pose, prev.keys.velocity, prev.keys.bias, s.keys.pose, s.keys.velocity});
+  window->AddResidualBlock(MakeBiasRandomWalk(config_, s.t - prev.t), nullptr,
+                           {prev.keys.bias, s.keys.bias});
+  result->imu_residuals = 1;
+}
+
+std::unique_ptr<LidarTerm> NavStateEstimator::MakeLidarTerm(const PreparedScan& scan,
+                                                            SlidingWindow*) const {
+  return std::make_unique<DeskewedLidarTerm>(*this, states_[states_.size() - 2], states_.back(),
+                                             scan.keypoints);
+}
+
+std::vector<Vec3> NavStateEstimator::MapPoints(const PreparedScan& scan) const {
+  const State& s = states_.back();
+  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t);
+  const SE3 T_wb = PoseManifold::Pose(s.pose);
+  std::vector<Vec3> map_points;
+  map_points.reserve(scan.points.size());
+  for (const TimedPoint& p : scan.points) map_points.push_back(T_wb * table.ToEnd(p.time, p.point));
+  return map_points;
+}
+
+}  // namespace ctlio::lio

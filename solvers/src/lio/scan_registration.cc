@@ -1,0 +1,84 @@
+#include "ctlio/solvers/lio/scan_registration.h"
+
+#include <chrono>
+#include <vector>
+
+#include "ctlio/solvers/lio/frontend.h"
+
+namespace ctlio::lio {
+
+namespace {
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& o) {
+  const double scale = o.loss_scale / o.point_noise_sigma;
+  if (o.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(scale);
+  if (o.loss == "huber") return std::make_unique<ceres::HuberLoss>(scale);
+  return nullptr;
+}
+
+ScanRegistration::ScanRegistration(const LidarFrontendOptions& options, int min_associations)
+    : options_(options), min_associations_(min_associations) {
+  options_.Validate();
+}
+
+RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* term,
+                                               SlidingWindow* window) const {
+  using Clock = std::chrono::steady_clock;
+  RegistrationSummary summary;
+  PlaneAssociator associator(map, options_);
+  std::vector<ceres::ResidualBlockId> blocks;
+  SE3 last_pose = term->NewestPose();
+  for (int round = 0; round < options_.max_iterations; ++round) {
+    // Associate: this round's residuals replace the previous round's.
+    auto t0 = Clock::now();
+    for (ceres::ResidualBlockId id : blocks) window->RemoveResidualBlock(id);
+    blocks.clear();
+    term->BeginRound();
+    // One loss per round, shared by its residuals; once a residual uses it the window owns it
+    // (ref-counted by Ceres, deleted with the last such residual).
+    std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
+    for (size_t i = 0; i < term->num_keypoints(); ++i) {
+      Vec3 q, p_map;
+      term->Locate(i, &q, &p_map);
+      PlaneAssociation a;
+      if (!associator.Associate(q, p_map, &a)) continue;
+      a.weight /= options_.point_noise_sigma;
+      blocks.push_back(term->AddResidual(i, a, loss.get(), window));
+    }
+    if (!blocks.empty()) loss.release();
+    summary.associations = static_cast<int>(blocks.size());
+    if (summary.associations < min_associations_) {
+      for (ceres::ResidualBlockId id : blocks) window->RemoveResidualBlock(id);
+      blocks.clear();
+      summary.degenerate = true;
+    }
+    summary.ms_associate += MsSince(t0);
+
+    // Solve.
+    t0 = Clock::now();
+    const ceres::Solver::Summary solved = window->Solve();
+    summary.ms_solve += MsSince(t0);
+    summary.rounds = round + 1;
+    summary.solver_iterations += static_cast<int>(solved.iterations.size());
+    if (round == 0) summary.initial_cost = solved.initial_cost;
+    summary.final_cost = solved.final_cost;
+
+    // Converged?
+    const SE3 pose = term->NewestPose();
+    const Vec6 step = (pose * last_pose.Inverse()).Log();
+    last_pose = pose;
+    if (summary.degenerate) break;
+    if (step.head<3>().norm() < options_.convergence_translation &&
+        step.tail<3>().norm() < options_.convergence_rotation) {
+      summary.converged = true;
+      break;
+    }
+  }
+  return summary;
+}
+
+}  // namespace ctlio::lio

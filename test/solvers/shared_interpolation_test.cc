@@ -1,0 +1,175 @@
+// The window's evaluation callback (SharedInterpolationCallback, a ceres::EvaluationCallback):
+// continuous-time point-to-plane residuals whose firings share one SharedPoseInterpolation must
+// (a) read the prepared interpolation in every evaluation of Ceres' solve and of the window's
+// own linearisation (marginalisation, covariance) — none interpolates on its own — and
+// (b) give the same solution and the same marginal prior as the same residuals without sharing.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/singer_prior.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/factors/priors/state_prior.h"
+#include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/solvers/sliding_window.h"
+
+namespace ctlio {
+namespace {
+
+constexpr double kT1 = 0.1;  // knot times 0 and kT1
+constexpr int kFirings = 12, kPointsPerFiring = 8;
+
+gp::SingerModel<6> Model() {
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  return gp::SingerModel<6>(qc, alpha);
+}
+
+struct Scene {
+  gp::KnotState truth0, truth1, guess0, guess1;
+  std::vector<double> tau;                            // per firing
+  std::vector<std::vector<PlaneAssociation>> planes;  // per firing
+};
+
+// Points seen from the true trajectory, each on a plane through its true map position.
+Scene MakeScene(uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto vec6 = [&](double s) {
+    Vec6 v;
+    for (int i = 0; i < 6; ++i) v[i] = s * u(rng);
+    return v;
+  };
+  Scene s;
+  s.truth0.pose = SE3(so3::Exp(Vec3(0.3, -0.2, 2.5)), Vec3(1, 2, 3));
+  s.truth0.velocity = vec6(1.0);
+  s.truth0.acceleration = vec6(2.0);
+  s.truth1.pose = SE3::Exp(kT1 * s.truth0.velocity) * s.truth0.pose;
+  s.truth1.velocity = s.truth0.velocity + kT1 * s.truth0.acceleration;
+  s.truth1.acceleration = s.truth0.acceleration;
+  s.guess0 = s.truth0;
+  s.guess1 = s.truth1;
+  s.guess0.pose = SE3::Exp(vec6(0.02)) * s.truth0.pose;
+  s.guess1.pose = SE3::Exp(vec6(0.05)) * s.truth1.pose;
+  s.guess1.velocity += vec6(0.2);
+  for (int f = 0; f < kFirings; ++f) {
+    s.tau.push_back(kT1 * (f + 0.5) / kFirings);
+    const gp::GpInterpolator interp(Model(), 0.0, kT1, s.tau.back());
+    SE3 T_rm;
+    interp.Pose(s.truth0, s.truth1, &T_rm, nullptr, nullptr);
+    s.planes.emplace_back();
+    for (int i = 0; i < kPointsPerFiring; ++i) {
+      PlaneAssociation a;
+      a.point_robot = 10.0 * Vec3(u(rng), u(rng), u(rng));
+      a.plane_normal = Vec3(u(rng), u(rng), u(rng)).normalized();
+      a.plane_point = T_rm.Inverse() * a.point_robot + 0.5 * a.plane_normal.unitOrthogonal();
+      a.weight = 1.0 / 0.05;
+      s.planes.back().push_back(a);
+    }
+  }
+  return s;
+}
+
+struct Built {
+  std::unique_ptr<SlidingWindow> window;
+  std::vector<std::shared_ptr<SharedPoseInterpolation>> firings;  // empty without sharing
+};
+
+Built Build(const Scene& s, bool shared) {
+  Built b;
+  SlidingWindowOptions options;
+  options.solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.solver.max_num_iterations = 20;
+  b.window = std::make_unique<SlidingWindow>(options);
+  SlidingWindow& w = *b.window;
+  const std::vector<StateId> ids = {0, 1, 2, 3, 4, 5};
+  for (const auto& [first, x] : {std::make_pair(0, &s.guess0), std::make_pair(3, &s.guess1)}) {
+    w.AddPoseState(first, x->pose);
+    w.AddVectorState(first + 1, x->velocity);
+    w.AddVectorState(first + 2, x->acceleration);
+  }
+  w.AddResidualBlock(
+      StatePrior::FromCovariance(s.guess0.pose, s.guess0.velocity, s.guess0.acceleration,
+                                 1e-2 * Eigen::Matrix<double, 18, 18>::Identity()),
+      nullptr, {0, 1, 2});
+  w.AddResidualBlock(new gp::SingerPrior(Model(), kT1), nullptr, ids);
+  const SharedPoseInterpolation::KnotBlocks blocks = {w.State(0), w.State(1), w.State(2),
+                                                      w.State(3), w.State(4), w.State(5)};
+  for (int f = 0; f < kFirings; ++f) {
+    auto interpolator = std::make_shared<const gp::GpInterpolator>(Model(), 0.0, kT1, s.tau[f]);
+    std::shared_ptr<SharedPoseInterpolation> firing;
+    if (shared) {
+      firing = std::make_shared<SharedPoseInterpolation>(interpolator, blocks);
+      w.shared_interpolations().Add(firing);
+      b.firings.push_back(firing);
+    }
+    for (const PlaneAssociation& a : s.planes[f]) {
+      ceres::CostFunction* cost = shared ? new ContinuousPointToPlane(firing, a)
+                                         : new ContinuousPointToPlane(interpolator, a);
+      w.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), ids);
+    }
+  }
+  return b;
+}
+
+int64_t Computed(const Built& b) {
+  int64_t n = 0;
+  for (const auto& f : b.firings) n += f->num_computed();
+  return n;
+}
+
+TEST(SharedInterpolationCallback, SolveReadsPreparedInterpolationAndMatchesUnshared) {
+  const Scene scene = MakeScene(3);
+  Built shared = Build(scene, true), plain = Build(scene, false);
+  EXPECT_EQ(shared.window->shared_interpolations().size(), static_cast<size_t>(kFirings));
+  const ceres::Solver::Summary a = shared.window->Solve();
+  const ceres::Solver::Summary b = plain.window->Solve();
+  EXPECT_GT(a.iterations.size(), 2u);
+  EXPECT_EQ(Computed(shared), 0) << "an evaluation inside the solve interpolated on its own";
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-9 * b.final_cost);
+  EXPECT_LT(a.final_cost, a.initial_cost);
+  for (StateId id = 0; id < 6; ++id) {
+    EXPECT_LT((shared.window->Vector(id) - plain.window->Vector(id)).cwiseAbs().maxCoeff(), 1e-9)
+        << "state " << id;
+  }
+}
+
+TEST(SharedInterpolationCallback, MarginalizationPreparesBeforeLinearising) {
+  const Scene scene = MakeScene(4);
+  Built shared = Build(scene, true), plain = Build(scene, false);
+  shared.window->Solve();
+  plain.window->Solve();
+  // Move the estimate after the solve, as a caller may: the last prepared point is stale.
+  for (Built* b : {&shared, &plain}) b->window->State(4)[0] += 0.01;
+  Eigen::MatrixXd H[2];
+  Eigen::VectorXd g[2];
+  int c = 0;
+  for (Built* b : {&shared, &plain}) {
+    std::vector<ceres::ResidualBlockId> all;
+    for (StateId id = 0; id < 6; ++id) {
+      for (ceres::ResidualBlockId r : b->window->ResidualBlocksOf(id)) all.push_back(r);
+    }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    b->window->Linearize(all, {0, 1, 2, 3, 4, 5}, &H[c], &g[c]);
+    ++c;
+  }
+  EXPECT_EQ(Computed(shared), 0) << "the linearisation interpolated per point";
+  EXPECT_LT((H[0] - H[1]).cwiseAbs().maxCoeff(), 1e-9 * H[1].cwiseAbs().maxCoeff());
+  EXPECT_LT((g[0] - g[1]).cwiseAbs().maxCoeff(), 1e-9 * g[1].cwiseAbs().maxCoeff() + 1e-12);
+  // Marginalising knot 0 removes its residuals: every firing expires from the callback.
+  const MarginalizationReport report = shared.window->Marginalize({0, 1, 2});
+  EXPECT_GT(report.prior_rank, 0);
+  EXPECT_EQ(Computed(shared), 0);
+  shared.firings.clear();
+  EXPECT_EQ(shared.window->shared_interpolations().size(), 0u);
+}
+
+}  // namespace
+}  // namespace ctlio
