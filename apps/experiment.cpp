@@ -6,6 +6,8 @@
 //
 //   ctlio_experiment --out /tmp/table2                       # the full experiment (hours)
 //   ctlio_experiment --out /tmp/t2 --sequences 3 --duration 5 --beams 32 --firing_decimation 4
+//   ctlio_experiment --out /tmp/nc --sim_preset newer_college --config data/newer_college_lio.yaml
+//                    --methods singer_lio,imu_input --sequences 5 --duration 60
 //
 // The reduced flags are for quick runs: the table records them in its header so that a reduced
 // table is never mistaken for the full one.
@@ -28,6 +30,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -35,13 +38,20 @@
 
 #include "ctlio/io/checked_output.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
+#include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/experiment_results.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(out, "", "Output folder (required)");
-DEFINE_string(config, "", "YAML config (default: data/sim_lio.yaml of the source tree)");
+DEFINE_string(config, "",
+              "YAML config (default: data/sim_lio.yaml of the source tree, "
+              "data/newer_college_lio.yaml with --sim_preset newer_college)");
 DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes (also walking, vehicle)");
+DEFINE_string(sim_preset, "",
+              "Recording preset: none | newer_college (sets world, regime, sensors, IMU, duration; "
+              "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
+              "win)");
 DEFINE_string(world, "box", "Simulated world: box | street | corridor | park | indoor");
 DEFINE_string(methods, "singer_lio,imu_input,lidar_gyro,lidar_only", "Comma-separated methods");
 DEFINE_int32(sequences, 20, "Sequences per regime (the paper: 20)");
@@ -147,11 +157,13 @@ void WriteBarSvg(const std::string& path,
 }
 
 // The settings that must be equal for runs to be pooled, one "key value" per line.
-std::string SettingsText(const std::string& config_path) {
+std::string SettingsText(const std::string& config_path, const std::string& preset,
+                         const std::string& world, const ctlio::sim::SimConfig& shared) {
   std::ostringstream s;
-  s << "world " << FLAGS_world << "\nduration_s " << FLAGS_duration << "\nbeams " << FLAGS_beams
-    << "\nfiring_decimation " << FLAGS_firing_decimation << "\nimu_model "
-    << (FLAGS_body_centric ? "body-centric" : "exact-specific-force") << "\nconfig "
+  s << "preset " << preset << "\nworld " << world << "\nduration_s " << shared.duration_s
+    << "\nbeams " << shared.lidar.beams << "\nfiring_decimation "
+    << shared.lidar.firing_decimation << "\nimu_model "
+    << (shared.imu.body_centric ? "body-centric" : "exact-specific-force") << "\nconfig "
     << std::filesystem::path(config_path).filename().string() << "\nfailure_ate_m "
     << FLAGS_failure_ate << "\n";
   return s.str();
@@ -187,15 +199,18 @@ void WriteTable(const std::string& out, const std::string& settings,
     hi = std::max(hi, *set.rbegin());
   }
   std::ostringstream md;
+  const std::string preset = kv.count("preset") ? kv.at("preset") : "none";
   md << "# Table II (ctlio): RMSE ATE [m] per regime, method and scenario, world " << kv.at("world")
-     << "\n\nSettings: " << per_regime << " sequences per regime (indices " << lo << "–" << hi
+     << (preset == "none" ? "" : ", preset " + preset) << "\n\nSettings: " << per_regime << " sequences per regime (indices " << lo << "–" << hi
      << "), " << kv.at("duration_s") << " s each, " << kv.at("beams")
      << " beams, firing decimation " << kv.at("firing_decimation") << ", " << kv.at("imu_model")
      << " IMU, config " << kv.at("config") << ". ";
-  const bool full = per_regime >= 20 && std::stod(kv.at("duration_s")) >= 20 &&
-                    std::stoi(kv.at("beams")) >= 128 && kv.at("firing_decimation") == "1";
-  md << (full ? "Full paper settings.\n\n"
-              : "**REDUCED settings** (not the paper's 20 × 20 s × 128 beams).\n\n");
+  const bool full = preset == "none" && per_regime >= 20 &&
+                    std::stod(kv.at("duration_s")) >= 20 && std::stoi(kv.at("beams")) >= 128 &&
+                    kv.at("firing_decimation") == "1";
+  md << (preset != "none" ? "Preset settings.\n\n"
+         : full           ? "Full paper settings.\n\n"
+                          : "**REDUCED settings** (not the paper's 20 × 20 s × 128 beams).\n\n");
   const auto cells = lioapp::PoolRows(rows);
   md << lioapp::PooledTableMarkdown(cells);
   md << "\n"
@@ -250,6 +265,16 @@ void Merge() {
 
 }  // namespace
 
+// A flag's value when it should apply: always without a preset, only if given explicitly with
+// one (the preset's value stands otherwise).
+template <class T>
+std::optional<T> Given(const char* flag, const T& value) {
+  if (FLAGS_sim_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
+    return value;
+  }
+  return std::nullopt;
+}
+
 int main(int argc, char** argv) {
   gflags::SetUsageMessage("Table II: Singer-LIO vs the IMU-as-input baseline in simulation");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
@@ -262,13 +287,26 @@ int main(int argc, char** argv) {
       return 0;
     }
     std::filesystem::create_directories(FLAGS_out);
+    // Default configuration: the one written for the simulated sensors.
     const std::string config_path =
-        FLAGS_config.empty() ? std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml" : FLAGS_config;
+        !FLAGS_config.empty() ? FLAGS_config
+        : FLAGS_sim_preset == "newer_college"
+            ? std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml"
+            : std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml";
     const lio::OdometryConfig base = lio::LoadOdometryConfig(config_path);
-    const auto regimes = Split(FLAGS_regimes);
+    const sim::Preset preset = sim::ParsePreset(FLAGS_sim_preset);
+    sim::SimOverrides given;  // the settings every sequence shares (regime: per job)
+    if (auto w = Given("world", FLAGS_world)) given.world = sim::ParseWorld(*w);
+    given.duration_s = Given("duration", FLAGS_duration);
+    given.beams = Given("beams", FLAGS_beams);
+    given.firing_decimation = Given("firing_decimation", FLAGS_firing_decimation);
+    given.body_centric = Given("body_centric", FLAGS_body_centric);
+    const std::string world_name = sim::WorldName(given.world.value_or(sim::PresetWorld(preset)));
+    const auto regimes =
+        Split(Given("regimes", FLAGS_regimes).value_or(sim::RegimeName(sim::PresetRegime(preset))));
     const auto methods = Split(FLAGS_methods);
     for (const auto& r : regimes) sim::ParseRegime(r);
-    sim::ParseWorld(FLAGS_world);
+    const sim::SimConfig shared = sim::PresetConfig(preset, 0, sim::kExperimentSeed, given);
     for (const auto& m : methods) lio::ParseLioMethod(m);
     // Scenarios: (name, outage length); the nominal one first.
     std::vector<std::pair<std::string, double>> scenarios;
@@ -317,19 +355,14 @@ int main(int argc, char** argv) {
       for (size_t k = next++; k < jobs.size(); k = next++) {
         Job& job = jobs[order[k]];
         try {
-          sim::SimConfig c =
-              sim::ExperimentConfig(sim::ParseRegime(job.regime), job.index, sim::kExperimentSeed,
-                                    sim::ParseWorld(FLAGS_world));
-          c.duration_s = FLAGS_duration;
-          c.lidar.beams = FLAGS_beams;
-          c.lidar.firing_decimation = FLAGS_firing_decimation;
-          c.imu.body_centric = FLAGS_body_centric;
+          sim::SimOverrides job_given = given;
+          job_given.regime = sim::ParseRegime(job.regime);
+          sim::SimConfig c = sim::PresetConfig(preset, job.index, sim::kExperimentSeed, job_given);
           if (job.outage_s > 0) {
-            c.imu.outages.push_back({0.5 * (FLAGS_duration - job.outage_s), job.outage_s});
+            c.imu.outages.push_back({0.5 * (c.duration_s - job.outage_s), job.outage_s});
           }
           sim::SimulatedSource source(c, "sim:" + job.regime + "/" + std::to_string(job.index));
-          lio::OdometryConfig config = base;
-          config.method = lio::ParseLioMethod(job.method);
+          const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(job.method));
           job.run = lioapp::RunOdometry(source, config, {}, FLAGS_failure_ate);
           job.done = true;
         } catch (const std::exception& e) {
@@ -375,7 +408,8 @@ int main(int argc, char** argv) {
       r.error = j.error;
       rows.push_back(r);
     }
-    const std::string settings = SettingsText(config_path);
+    const std::string settings =
+        SettingsText(config_path, sim::PresetName(preset), world_name, shared);
     io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
     lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
     const double el =

@@ -7,6 +7,8 @@
 //    start|end])
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
 //   ctlio_odometry --format sim --sim_imu_dropout 5:1 ...   # no IMU samples in [5 s, 6 s)
+//   ctlio_odometry --format sim --sim_preset newer_college --sim_index 0 \
+//                  --config data/newer_college_lio.yaml --out DIR
 //
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
 // --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
@@ -32,6 +34,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "ctlio/io/checked_output.h"
@@ -42,6 +45,7 @@
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/input_checks.h"
+#include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/yaml_io.h"
 #include "lio/run_odometry.h"
@@ -76,6 +80,8 @@ DEFINE_double(max_imu_gap_error, 0.0,
               "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
               "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
+DEFINE_string(sim_preset, "",
+              "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
@@ -90,19 +96,35 @@ namespace {
 
 using namespace ctlio;
 
+// A --sim_* flag's value when it should apply: always without a preset, only if given
+// explicitly with one (the preset's value stands otherwise).
+template <class T>
+std::optional<T> Given(const char* flag, const T& value) {
+  if (FLAGS_sim_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
+    return value;
+  }
+  return std::nullopt;
+}
+
 std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
   const int64_t gap_ns = std::llround(max_imu_gap_error_s * 1e9);
   if (FLAGS_format == "sim") {
-    sim::SimConfig c =
-        sim::ExperimentConfig(sim::ParseRegime(FLAGS_sim_regime), FLAGS_sim_index,
-                              sim::kExperimentSeed, sim::ParseWorld(FLAGS_sim_world));
-    c.duration_s = FLAGS_sim_duration;
-    c.lidar.firing_decimation = FLAGS_sim_firing_decimation;
-    c.lidar.beams = FLAGS_sim_beams;
+    const sim::Preset preset = sim::ParsePreset(FLAGS_sim_preset);
+    sim::SimOverrides given;
+    if (auto r = Given("sim_regime", FLAGS_sim_regime)) given.regime = sim::ParseRegime(*r);
+    if (auto w = Given("sim_world", FLAGS_sim_world)) given.world = sim::ParseWorld(*w);
+    given.duration_s = Given("sim_duration", FLAGS_sim_duration);
+    given.firing_decimation = Given("sim_firing_decimation", FLAGS_sim_firing_decimation);
+    given.beams = Given("sim_beams", FLAGS_sim_beams);
+    sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
+    const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
     std::ostringstream name;
-    name << "sim:" << (FLAGS_sim_world == "box" ? "" : FLAGS_sim_world + "/") << FLAGS_sim_regime
-         << "/" << FLAGS_sim_index;
+    name << "sim:"
+         << (preset == sim::Preset::kNone ? "" : std::string(sim::PresetName(preset)) + ":")
+         << (world == sim::WorldKind::kBox ? "" : std::string(sim::WorldName(world)) + "/")
+         << sim::RegimeName(given.regime.value_or(sim::PresetRegime(preset))) << "/"
+         << FLAGS_sim_index;
     return std::make_unique<sim::SimulatedSource>(c, name.str());
   }
   if (FLAGS_dataset.empty()) throw std::runtime_error("--dataset is required (or --format sim)");
@@ -197,8 +219,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
     for (const std::string& m : methods) {
-      lio::OdometryConfig config = base;
-      config.method = lio::ParseLioMethod(m);
+      const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
       auto source = OpenSource(checks.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);

@@ -7,8 +7,10 @@
 //                  [--firing_decimation=4] [--duration=20] [--body_centric] [--pillars=4]
 //   ctlio_simulate --world=street --regime=vehicle --output=/tmp/street [--topview=street.svg]
 //                  [--imu_dropout=5.0:0.5,12:2] [--lidar_dropout=0.1] [--gyro_limit=4] ...
+//   ctlio_simulate --preset=newer_college --layout=newer_college --index=0 --output=/tmp/nc_00
 //
-// Realism and outage flags default to off (the simulator of SPEC §6).
+// Realism and outage flags default to off (the simulator of SPEC §6). A preset (presets.h) sets
+// sensor, IMU, extrinsic, world, regime and duration; flags given explicitly override it.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -17,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -25,8 +28,10 @@
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
+#include "ctlio/sim/presets.h"
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
+DEFINE_string(preset, "", "Recording preset: none | newer_college (explicit flags override it)");
 DEFINE_string(layout, "ctlio", "Layout: ctlio | newer_college | rosbag (a .bag file)");
 DEFINE_string(bag_compression, "none", "--layout rosbag: chunk compression none | lz4 | bz2");
 DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | vehicle");
@@ -66,6 +71,14 @@ DEFINE_bool(newer_college_extrinsic, false,
 
 namespace {
 
+// A flag's value when it should apply: always without a preset, only if given explicitly with
+// one (the preset's value stands otherwise).
+template <class T>
+std::optional<T> Given(const char* flag, const T& value) {
+  if (FLAGS_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return value;
+  return std::nullopt;
+}
+
 // "a,b,c" → Vec3 (one number repeats on all axes).
 ctlio::Vec3 ParseVec3(const std::string& flag, const std::string& text) {
   std::stringstream in(text);
@@ -99,22 +112,34 @@ int main(int argc, char** argv) {
   }
   try {
     using namespace ctlio;
-    const sim::Regime regime = sim::ParseRegime(FLAGS_regime);
-    // inf wrote 0 scans with exit 0, nan failed in vector::reserve.
-    if (!(FLAGS_duration > 0.0 && FLAGS_duration <= 3600.0)) {
-      throw std::runtime_error("--duration must be in (0, 3600] s");
-    }
-    if (FLAGS_firing_decimation < 1 || FLAGS_beams < 1) {
-      throw std::runtime_error("--firing_decimation and --beams must be >= 1");
-    }
-    const sim::WorldKind world = sim::ParseWorld(FLAGS_world);
+    const sim::Preset preset = sim::ParsePreset(FLAGS_preset);
+    sim::SimOverrides given;
+    if (auto r = Given("regime", FLAGS_regime)) given.regime = sim::ParseRegime(*r);
+    if (auto w = Given("world", FLAGS_world)) given.world = sim::ParseWorld(*w);
+    given.duration_s = Given("duration", FLAGS_duration);
+    given.beams = Given("beams", FLAGS_beams);
+    given.firing_decimation = Given("firing_decimation", FLAGS_firing_decimation);
+    given.range_noise_per_m = Given("range_noise_per_m", FLAGS_range_noise_per_m);
+    given.body_centric = Given("body_centric", FLAGS_body_centric);
+    given.accel_bias_walk = Given("bias_walk_accel", FLAGS_bias_walk_accel);
+    given.gyro_bias_walk = Given("bias_walk_gyro", FLAGS_bias_walk_gyro);
+    given.newer_college_extrinsic = Given("newer_college_extrinsic", FLAGS_newer_college_extrinsic);
+    const sim::Regime regime = given.regime.value_or(sim::PresetRegime(preset));
+    const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
+    const std::string regime_name = sim::RegimeName(regime), world_name = sim::WorldName(world);
     if (FLAGS_pillars > 0 && world != sim::WorldKind::kBox) {
       throw std::runtime_error("--pillars is a box-world option");
     }
-    sim::SimConfig config = sim::ExperimentConfig(regime, FLAGS_index, FLAGS_seed, world);
+    sim::SimConfig config = sim::PresetConfig(preset, FLAGS_index, FLAGS_seed, given);
+    // inf wrote 0 scans with exit 0, nan failed in vector::reserve.
+    if (!(config.duration_s > 0.0 && config.duration_s <= 3600.0)) {
+      throw std::runtime_error("--duration must be in (0, 3600] s");
+    }
+    if (config.lidar.firing_decimation < 1 || config.lidar.beams < 1) {
+      throw std::runtime_error("--firing_decimation and --beams must be >= 1");
+    }
     config.world.seed = FLAGS_world_seed;
     auto& L = config.lidar;
-    L.range_noise_per_m = FLAGS_range_noise_per_m;
     L.dropout = FLAGS_lidar_dropout;
     L.max_incidence_deg = FLAGS_max_incidence_deg;
     L.reflect_range = FLAGS_reflect_range;
@@ -129,16 +154,8 @@ int main(int argc, char** argv) {
     I.outage_rate = FLAGS_imu_outage_rate;
     I.outage_length_min = FLAGS_imu_outage_min;
     I.outage_length_max = FLAGS_imu_outage_max;
-    config.duration_s = FLAGS_duration;
-    config.lidar.firing_decimation = FLAGS_firing_decimation;
-    config.lidar.beams = FLAGS_beams;
-    config.imu.body_centric = FLAGS_body_centric;
-    config.imu.accel_bias_walk = FLAGS_bias_walk_accel;
-    config.imu.gyro_bias_walk = FLAGS_bias_walk_gyro;
     // The Newer College layout carries no extrinsic and is read with the published one.
-    if (FLAGS_newer_college_extrinsic || FLAGS_layout == "newer_college") {
-      config.imu_from_lidar = io::NewerCollegeImuFromLidar();
-    }
+    if (FLAGS_layout == "newer_college") config.imu_from_lidar = io::NewerCollegeImuFromLidar();
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
     if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
     std::mt19937_64 rng(FLAGS_seed + 17);
@@ -153,12 +170,22 @@ int main(int argc, char** argv) {
     }
 
     std::ostringstream yaml;
-    yaml << "{world: " << FLAGS_world << ", world_seed: " << FLAGS_world_seed
-         << ", regime: " << FLAGS_regime << ", index: " << FLAGS_index << ", seed: " << FLAGS_seed
-         << ", duration_s: " << FLAGS_duration << ", firing_decimation: " << FLAGS_firing_decimation
-         << ", beams: " << FLAGS_beams
-         << ", body_centric: " << (FLAGS_body_centric ? "true" : "false")
-         << ", pillars: " << FLAGS_pillars << ", range_noise_per_m: " << FLAGS_range_noise_per_m
+    yaml << "{preset: " << sim::PresetName(preset) << ", world: " << world_name
+         << ", world_seed: " << FLAGS_world_seed << ", regime: " << regime_name
+         << ", index: " << FLAGS_index << ", seed: " << FLAGS_seed
+         << ", duration_s: " << config.duration_s
+         << ", firing_decimation: " << config.lidar.firing_decimation
+         << ", beams: " << config.lidar.beams
+         << ", firings_per_revolution: " << config.lidar.firings_per_revolution
+         << ", elevation_deg: [" << config.lidar.min_elevation_deg << ", "
+         << config.lidar.max_elevation_deg << "], lidar_rate_hz: " << config.lidar.rate_hz
+         << ", range_noise: " << config.lidar.range_noise << ", imu_rate_hz: " << config.imu.rate_hz
+         << ", accel_noise: " << config.imu.accel_noise << ", gyro_noise: " << config.imu.gyro_noise
+         << ", bias_walk_accel: " << config.imu.accel_bias_walk
+         << ", bias_walk_gyro: " << config.imu.gyro_bias_walk
+         << ", body_centric: " << (config.imu.body_centric ? "true" : "false")
+         << ", pillars: " << FLAGS_pillars
+         << ", range_noise_per_m: " << config.lidar.range_noise_per_m
          << ", lidar_dropout: " << FLAGS_lidar_dropout
          << ", max_incidence_deg: " << FLAGS_max_incidence_deg
          << ", reflect_range: " << FLAGS_reflect_range
@@ -182,11 +209,11 @@ int main(int argc, char** argv) {
 
     const auto t0 = std::chrono::steady_clock::now();
     std::ostringstream name;
-    name << "sim:" << (world == sim::WorldKind::kBox ? "" : FLAGS_world + "/") << FLAGS_regime
-         << "/" << FLAGS_index;
+    name << "sim:" << (world == sim::WorldKind::kBox ? "" : world_name + "/") << regime_name << "/"
+         << FLAGS_index;
     sim::SimulatedSource source(config, name.str());
     if (!FLAGS_topview.empty()) {
-      sim::WriteTopViewSvg(source.simulator().world(), FLAGS_topview, "world " + FLAGS_world);
+      sim::WriteTopViewSvg(source.simulator().world(), FLAGS_topview, "world " + world_name);
     }
     if (!source.simulator().ImuOutages().empty()) {
       std::ostringstream msg;

@@ -21,7 +21,7 @@ TEST(OdometryConfig, ShippedConfigsLoad) {
   EXPECT_TRUE(sim.exact_specific_force);
   const OdometryConfig nc =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
-  // SPEC §4: the paper's Newer College values.
+  // SPEC §4: the paper's Newer College values where the file keeps them.
   EXPECT_DOUBLE_EQ(nc.qc[0], 5000);
   EXPECT_DOUBLE_EQ(nc.qc[3], 500);
   EXPECT_DOUBLE_EQ(nc.alpha[3], 100);
@@ -31,6 +31,15 @@ TEST(OdometryConfig, ShippedConfigsLoad) {
   // The published lidar→IMU extrinsic: rotation diag(−1, −1, 1).
   EXPECT_NEAR(nc.T_imu_lidar.rotation()(0, 0), -1.0, 1e-12);
   EXPECT_NEAR(nc.T_imu_lidar.translation().x(), -0.006253, 1e-12);
+  // The exact specific force, a bounded per-scan cost, and the baseline's own override.
+  EXPECT_TRUE(nc.exact_specific_force);
+  EXPECT_GT(nc.frontend.max_keypoints, 0);
+  const OdometryConfig nc_input = nc.ForMethod(LioMethod::kImuInput);
+  EXPECT_GT(nc_input.frontend.max_iterations, nc.frontend.max_iterations);
+  EXPECT_GE(nc_input.frontend.max_keypoints, nc.frontend.max_keypoints);
+  EXPECT_DOUBLE_EQ(nc_input.qc[0], nc.qc[0]);  // keys it does not name: the base's
+  EXPECT_EQ(nc.ForMethod(LioMethod::kSingerLio).frontend.max_iterations,
+            nc.frontend.max_iterations);
 }
 
 TEST(OdometryConfig, UnknownKeyNamesFileAndLine) {

@@ -37,9 +37,9 @@ void LidarFrontendOptions::Validate() const {
           "convergence thresholds must be >= 0");
 }
 
-LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
-                                                  const std::string& source) {
-  LidarFrontendOptions o;
+LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const std::string& source,
+                                                  const LidarFrontendOptions& base) {
+  LidarFrontendOptions o = base;
   if (!node.IsDefined() || node.IsNull()) return o;
   if (!node.IsMap()) {
     throw std::runtime_error(YamlWhere(source, node.Mark()) +

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <stdexcept>
 
 #include "ctlio/solvers/lio/yaml_io.h"
@@ -112,92 +113,158 @@ void OdometryConfig::Validate() const {
   require(solver_threads >= 1, "window solver settings must be >= 1");
 }
 
+namespace {
+
+// The parts of the top level that are combined after reading (method name, extrinsic pieces,
+// the per-method overrides).
+struct TopLevel {
+  std::string method;
+  bool have_extrinsic = false;
+  Vec6 extrinsic_xyz_rpy = Vec6::Zero();
+  std::vector<double> extrinsic_rotation;  // optional 3×3 row-major
+  YAML::Node per_method;
+};
+
+// Applies the sections of the mapping `root` onto *c: keys absent keep *c's values. `top` is
+// null inside a per-method override, where only the method-dependent sections (gp, imu, init,
+// window, lidar_frontend) are allowed; `where` prefixes key names in messages.
+void ApplySections(const YAML::Node& root, const std::string& source, const std::string& where,
+                   OdometryConfig* c, TopLevel* top) {
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node& v = kv.second;
+    const std::string section = where + key;
+    if (top == nullptr && (key == "method" || key == "extrinsic" || key == "per_method")) {
+      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": '" + section +
+                               "' cannot be set per method");
+    }
+    if (key == "method") {
+      top->method = v.as<std::string>();
+    } else if (key == "per_method") {
+      if (!v.IsMap()) {
+        throw std::runtime_error(YamlWhere(source, v.Mark()) +
+                                 ": 'per_method' must be a mapping of method names");
+      }
+      top->per_method = v;
+    } else if (key == "gp") {
+      ReadSection(v, section, source, {{"qc", SetVec6(&c->qc)}, {"alpha", SetVec6(&c->alpha)}});
+    } else if (key == "imu") {
+      ReadSection(v, section, source,
+                  {{"accel_variance", SetFromYaml(&c->accel_variance)},
+                   {"accel_loss_scale", SetFromYaml(&c->accel_loss_scale)},
+                   {"gyro_variance", SetFromYaml(&c->gyro_variance)},
+                   {"bias_accel_walk", SetFromYaml(&c->bias_accel_walk)},
+                   {"bias_gyro_walk", SetFromYaml(&c->bias_gyro_walk)},
+                   {"bias_walk_period", SetFromYaml(&c->bias_walk_period)},
+                   {"initial_bias_accel_variance", SetFromYaml(&c->initial_bias_accel_variance)},
+                   {"initial_bias_gyro_variance", SetFromYaml(&c->initial_bias_gyro_variance)},
+                   {"gravity", SetFromYaml(&c->gravity)},
+                   {"exact_specific_force", SetFromYaml(&c->exact_specific_force)},
+                   {"input_accel_sigma", SetFromYaml(&c->input_accel_sigma)},
+                   {"input_gyro_sigma", SetFromYaml(&c->input_gyro_sigma)},
+                   {"rate_hint", SetFromYaml(&c->imu_rate_hint)},
+                   {"gap_velocity_walk", SetFromYaml(&c->gap_velocity_walk)},
+                   {"gap_hold_max", SetFromYaml(&c->gap_hold_max)},
+                   {"gap_zero_order_hold", SetFromYaml(&c->gap_zero_order_hold)}});
+    } else if (key == "init") {
+      ReadSection(v, section, source,
+                  {{"gravity_duration", SetFromYaml(&c->gravity_init_duration)},
+                   {"gravity_max_std", SetFromYaml(&c->gravity_init_max_std)},
+                   {"min_associations", SetFromYaml(&c->min_associations)},
+                   {"max_imu_gap", SetFromYaml(&c->max_imu_gap)},
+                   {"max_scan_translation", SetFromYaml(&c->max_scan_translation)}});
+    } else if (key == "window") {
+      ReadSection(v, section, source,
+                  {{"knots", SetFromYaml(&c->window_knots)},
+                   {"threads", SetFromYaml(&c->solver_threads)},
+                   {"estimate_gravity", SetFromYaml(&c->estimate_gravity)}});
+    } else if (key == "extrinsic") {
+      top->have_extrinsic = true;
+      ReadSection(v, key, source,
+                  {{"xyz_rpy", SetVec6(&top->extrinsic_xyz_rpy)},
+                   {"rotation", SetFromYaml(&top->extrinsic_rotation)},
+                   {"translation", [top](const YAML::Node& n) {
+                      const auto t = n.as<std::vector<double>>();
+                      if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
+                      top->extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
+                    }}});
+    } else if (key == "lidar_frontend") {
+      c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
+    } else {
+      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + section +
+                               "'");
+    }
+  }
+}
+
+void ValidateNaming(const OdometryConfig& c, const std::string& source, const std::string& what) {
+  try {
+    c.Validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(source + what + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+OdometryConfig OdometryConfig::ForMethod(LioMethod m) const {
+  const auto it = per_method.find(m);
+  OdometryConfig c = it == per_method.end() ? *this : *it->second;
+  c.method = m;
+  c.per_method.clear();
+  return c;
+}
+
 OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string& source) {
   OdometryConfig c;
   if (!root.IsDefined() || root.IsNull()) return c;
   if (!root.IsMap()) throw std::runtime_error(source + ": the config must be a YAML mapping");
-  std::string method = LioMethodName(c.method);
-  Vec6 extrinsic_xyz_rpy = Vec6::Zero();
-  std::vector<double> extrinsic_rotation;  // optional 3×3 row-major
-  bool have_extrinsic = false;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const YAML::Node& v = kv.second;
-    if (key == "method") {
-      method = v.as<std::string>();
-    } else if (key == "gp") {
-      ReadSection(v, key, source, {{"qc", SetVec6(&c.qc)}, {"alpha", SetVec6(&c.alpha)}});
-    } else if (key == "imu") {
-      ReadSection(v, key, source,
-                  {{"accel_variance", SetFromYaml(&c.accel_variance)},
-                   {"accel_loss_scale", SetFromYaml(&c.accel_loss_scale)},
-                   {"gyro_variance", SetFromYaml(&c.gyro_variance)},
-                   {"bias_accel_walk", SetFromYaml(&c.bias_accel_walk)},
-                   {"bias_gyro_walk", SetFromYaml(&c.bias_gyro_walk)},
-                   {"bias_walk_period", SetFromYaml(&c.bias_walk_period)},
-                   {"initial_bias_accel_variance", SetFromYaml(&c.initial_bias_accel_variance)},
-                   {"initial_bias_gyro_variance", SetFromYaml(&c.initial_bias_gyro_variance)},
-                   {"gravity", SetFromYaml(&c.gravity)},
-                   {"exact_specific_force", SetFromYaml(&c.exact_specific_force)},
-                   {"input_accel_sigma", SetFromYaml(&c.input_accel_sigma)},
-                   {"input_gyro_sigma", SetFromYaml(&c.input_gyro_sigma)},
-                   {"rate_hint", SetFromYaml(&c.imu_rate_hint)},
-                   {"gap_velocity_walk", SetFromYaml(&c.gap_velocity_walk)},
-                   {"gap_hold_max", SetFromYaml(&c.gap_hold_max)},
-                   {"gap_zero_order_hold", SetFromYaml(&c.gap_zero_order_hold)}});
-    } else if (key == "init") {
-      ReadSection(v, key, source,
-                  {{"gravity_duration", SetFromYaml(&c.gravity_init_duration)},
-                   {"gravity_max_std", SetFromYaml(&c.gravity_init_max_std)},
-                   {"min_associations", SetFromYaml(&c.min_associations)},
-                   {"max_imu_gap", SetFromYaml(&c.max_imu_gap)},
-                   {"max_scan_translation", SetFromYaml(&c.max_scan_translation)}});
-    } else if (key == "window") {
-      ReadSection(v, key, source,
-                  {{"knots", SetFromYaml(&c.window_knots)},
-                   {"threads", SetFromYaml(&c.solver_threads)},
-                   {"estimate_gravity", SetFromYaml(&c.estimate_gravity)}});
-    } else if (key == "extrinsic") {
-      have_extrinsic = true;
-      ReadSection(v, key, source,
-                  {{"xyz_rpy", SetVec6(&extrinsic_xyz_rpy)},
-                   {"rotation", SetFromYaml(&extrinsic_rotation)},
-                   {"translation", [&](const YAML::Node& n) {
-                      const auto t = n.as<std::vector<double>>();
-                      if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
-                      extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
-                    }}});
-    } else if (key == "lidar_frontend") {
-      c.frontend = LidarFrontendOptionsFromYaml(v, source);
-    } else {
-      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + key + "'");
-    }
-  }
+  TopLevel top;
+  top.method = LioMethodName(c.method);
+  ApplySections(root, source, "", &c, &top);
   try {
-    c.method = ParseLioMethod(method);
+    c.method = ParseLioMethod(top.method);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(source + ": " + e.what());
   }
-  if (have_extrinsic) {
+  if (top.have_extrinsic) {
     Mat3 C;
-    if (!extrinsic_rotation.empty()) {
-      if (extrinsic_rotation.size() != 9)
+    if (!top.extrinsic_rotation.empty()) {
+      if (top.extrinsic_rotation.size() != 9)
         throw std::runtime_error(source + ": extrinsic.rotation needs 9 numbers (row-major)");
-      C = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(extrinsic_rotation.data());
+      C = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+          top.extrinsic_rotation.data());
       if ((C * C.transpose() - Mat3::Identity()).norm() > 1e-6 || C.determinant() < 0)
         throw std::runtime_error(source + ": extrinsic.rotation is not a rotation matrix");
     } else {
-      const Vec3 rpy = extrinsic_xyz_rpy.tail<3>();
+      const Vec3 rpy = top.extrinsic_xyz_rpy.tail<3>();
       C = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
            Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
               .toRotationMatrix();
     }
-    c.T_imu_lidar = SE3(C, extrinsic_xyz_rpy.head<3>());
+    c.T_imu_lidar = SE3(C, top.extrinsic_xyz_rpy.head<3>());
   }
-  try {
-    c.Validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(source + ": " + e.what());
+  ValidateNaming(c, source, "");
+  // Per-method overrides: each applied onto the complete base (whatever the key order).
+  if (top.per_method) {
+    for (const auto& kv : top.per_method) {
+      const std::string name = kv.first.as<std::string>();
+      LioMethod m;
+      try {
+        m = ParseLioMethod(name);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": per_method: " + e.what());
+      }
+      if (!kv.second.IsMap()) {
+        throw std::runtime_error(YamlWhere(source, kv.second.Mark()) + ": 'per_method." + name +
+                                 "' must be a YAML mapping");
+      }
+      auto override_config = std::make_shared<OdometryConfig>(c);
+      ApplySections(kv.second, source, "per_method." + name + ".", override_config.get(), nullptr);
+      override_config->method = m;
+      ValidateNaming(*override_config, source, " (per_method." + name + ")");
+      c.per_method[m] = override_config;
+    }
   }
   return c;
 }

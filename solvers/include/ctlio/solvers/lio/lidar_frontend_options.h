@@ -59,10 +59,12 @@ struct LidarFrontendOptions {
   void Validate() const;
 };
 
-// Reads the options from a YAML mapping; keys not present keep their defaults; unknown keys and
-// ill-typed values throw std::runtime_error naming `source` and the line.
+// Reads the options from a YAML mapping; keys not present keep their value in `base` (the
+// defaults unless given); unknown keys and ill-typed values throw std::runtime_error naming
+// `source` and the line.
 LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node,
-                                                  const std::string& source = "<yaml>");
+                                                  const std::string& source = "<yaml>",
+                                                  const LidarFrontendOptions& base = {});
 LidarFrontendOptions LoadLidarFrontendOptions(const std::string& path);
 
 }  // namespace ctlio::lio

@@ -9,6 +9,8 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -93,12 +95,25 @@ struct OdometryConfig {
   // --- Sensor setup.
   SE3 T_imu_lidar;  // lidar → robot (IMU) frame
 
+  // --- Per-method overrides (YAML key `per_method`): the complete configuration to use when
+  // running that method, i.e. this one with the override's keys replaced. One file can so
+  // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side.
+  std::map<LioMethod, std::shared_ptr<const OdometryConfig>> per_method;
+  // The configuration that runs `m`: its override if there is one, else this one; `method` = m.
+  OdometryConfig ForMethod(LioMethod m) const;
+
   void Validate() const;  // throws std::invalid_argument naming the bad field
 };
 
 // Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
-// `lidar_frontend`. Missing keys keep their defaults; unknown keys and bad values throw
-// std::runtime_error naming file and line.
+// `lidar_frontend` and `per_method`. Missing keys keep their defaults; unknown keys and bad
+// values throw std::runtime_error naming file and line. `per_method` maps a method name
+// (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`, `window`,
+// `lidar_frontend` whose keys replace the base values for that method only (same keys, same
+// checks; `method` and `extrinsic` cannot be set per method):
+//   lidar_frontend: {max_iterations: 3}
+//   per_method:
+//     imu_input: {lidar_frontend: {max_iterations: 5}}
 OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string& source);
 OdometryConfig LoadOdometryConfig(const std::string& path);
 

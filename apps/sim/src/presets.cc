@@ -1,0 +1,69 @@
+#include "ctlio/sim/presets.h"
+
+#include <stdexcept>
+
+#include "ctlio/io/newer_college.h"
+
+namespace ctlio::sim {
+
+Preset ParsePreset(const std::string& name) {
+  if (name.empty() || name == "none") return Preset::kNone;
+  if (name == "newer_college") return Preset::kNewerCollege;
+  throw std::runtime_error("unknown preset '" + name + "' (none, newer_college)");
+}
+
+const char* PresetName(Preset preset) {
+  return preset == Preset::kNewerCollege ? "newer_college" : "none";
+}
+
+Regime PresetRegime(Preset preset) {
+  return preset == Preset::kNewerCollege ? Regime::kWalking : Regime::kFast;
+}
+
+WorldKind PresetWorld(Preset preset) {
+  return preset == Preset::kNewerCollege ? WorldKind::kPark : WorldKind::kBox;
+}
+
+double PresetDuration(Preset preset) { return preset == Preset::kNewerCollege ? 120.0 : 20.0; }
+
+void ApplyNewerCollegeSensors(SimConfig* config) {
+  LidarConfig& L = config->lidar;
+  L.beams = 64;
+  L.min_elevation_deg = -16.6;
+  L.max_elevation_deg = 16.6;
+  L.firings_per_revolution = 1024;
+  L.rate_hz = 10.0;
+  L.range_noise = 0.015;
+  L.range_noise_per_m = 0.0005;
+  L.min_range = 0.8;
+  L.max_range = 120.0;
+  ImuConfig& I = config->imu;
+  I.rate_hz = 100.0;
+  I.accel_noise = 0.05;
+  I.gyro_noise = 0.005;
+  I.accel_bias_walk = 1e-3;
+  I.gyro_bias_walk = 1e-4;
+  I.body_centric = false;
+  I.gravity = 9.81599;
+  config->imu_from_lidar = io::NewerCollegeImuFromLidar();
+}
+
+SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrides& o) {
+  SimConfig c = ExperimentConfig(o.regime.value_or(PresetRegime(preset)), index, seed,
+                                 o.world.value_or(PresetWorld(preset)));
+  c.duration_s = PresetDuration(preset);
+  if (preset == Preset::kNewerCollege) ApplyNewerCollegeSensors(&c);
+  if (o.duration_s) c.duration_s = *o.duration_s;
+  if (o.beams) c.lidar.beams = *o.beams;
+  if (o.firing_decimation) c.lidar.firing_decimation = *o.firing_decimation;
+  if (o.range_noise_per_m) c.lidar.range_noise_per_m = *o.range_noise_per_m;
+  if (o.body_centric) c.imu.body_centric = *o.body_centric;
+  if (o.accel_bias_walk) c.imu.accel_bias_walk = *o.accel_bias_walk;
+  if (o.gyro_bias_walk) c.imu.gyro_bias_walk = *o.gyro_bias_walk;
+  if (o.newer_college_extrinsic) {
+    c.imu_from_lidar = *o.newer_college_extrinsic ? io::NewerCollegeImuFromLidar() : SE3();
+  }
+  return c;
+}
+
+}  // namespace ctlio::sim

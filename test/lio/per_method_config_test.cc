@@ -1,0 +1,91 @@
+// Per-method overrides in the odometry configuration (`per_method`): an override replaces only
+// its keys and only for its method, applies onto the complete base whatever the key order, and
+// keeps the file's rules (unknown keys and bad values name file and line; method and extrinsic
+// are not per-method settings).
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "ctlio/solvers/lio/odometry_config.h"
+
+namespace ctlio::lio {
+namespace {
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Expects LoadOdometryConfig(text) to throw naming the file, `line` and `needle`.
+void ExpectError(const std::string& name, const std::string& text, int line,
+                 const std::string& needle) {
+  const std::string path = WriteTemp(name, text);
+  try {
+    LoadOdometryConfig(path);
+    ADD_FAILURE() << "expected an error for:\n" << text;
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path + ":" + std::to_string(line)), std::string::npos) << what;
+    EXPECT_NE(what.find(needle), std::string::npos) << what;
+  }
+}
+
+TEST(PerMethodConfig, OverrideReplacesOnlyItsKeysForItsMethod) {
+  // The override comes first in the file: it still applies onto the complete base.
+  const OdometryConfig c = LoadOdometryConfig(WriteTemp("pm.yaml",
+                                                        "per_method:\n"
+                                                        "  imu_input:\n"
+                                                        "    lidar_frontend:\n"
+                                                        "      max_iterations: 7\n"
+                                                        "    imu:\n"
+                                                        "      input_accel_sigma: 0.3\n"
+                                                        "method: singer_lio\n"
+                                                        "imu:\n"
+                                                        "  input_accel_sigma: 0.1\n"
+                                                        "  gyro_variance: 0.002\n"
+                                                        "lidar_frontend:\n"
+                                                        "  max_iterations: 2\n"
+                                                        "  max_keypoints: 400\n"));
+  EXPECT_EQ(c.method, LioMethod::kSingerLio);
+  const OdometryConfig singer = c.ForMethod(LioMethod::kSingerLio);
+  EXPECT_EQ(singer.method, LioMethod::kSingerLio);
+  EXPECT_EQ(singer.frontend.max_iterations, 2);
+  EXPECT_DOUBLE_EQ(singer.input_accel_sigma, 0.1);
+  const OdometryConfig input = c.ForMethod(LioMethod::kImuInput);
+  EXPECT_EQ(input.method, LioMethod::kImuInput);
+  EXPECT_EQ(input.frontend.max_iterations, 7);
+  EXPECT_DOUBLE_EQ(input.input_accel_sigma, 0.3);
+  // Keys the override does not name keep the base's values (not the defaults).
+  EXPECT_EQ(input.frontend.max_keypoints, 400);
+  EXPECT_DOUBLE_EQ(input.gyro_variance, 0.002);
+  EXPECT_TRUE(input.per_method.empty());
+  // A method without an override runs the base.
+  const OdometryConfig gyro = c.ForMethod(LioMethod::kLidarGyro);
+  EXPECT_EQ(gyro.method, LioMethod::kLidarGyro);
+  EXPECT_EQ(gyro.frontend.max_iterations, 2);
+}
+
+TEST(PerMethodConfig, ErrorsNameFileAndLine) {
+  ExpectError("pm_key.yaml", "per_method:\n  imu_input:\n    imu:\n      input_acel_sigma: 1\n", 4,
+              "per_method.imu_input.imu.input_acel_sigma");
+  ExpectError("pm_fe.yaml", "per_method:\n  singer_lio:\n    lidar_frontend:\n      max_iter: 1\n",
+              4, "max_iter");
+  ExpectError("pm_method.yaml", "per_method:\n  kalman:\n    imu: {}\n", 2, "kalman");
+  ExpectError("pm_ext.yaml",
+              "per_method:\n  imu_input:\n    extrinsic:\n      xyz_rpy: [0,0,0,0,0,0]\n", 3,
+              "cannot be set per method");
+  ExpectError("pm_nest.yaml", "per_method:\n  imu_input:\n    method: singer_lio\n", 3,
+              "cannot be set per method");
+  ExpectError("pm_type.yaml", "per_method:\n  imu_input:\n    window:\n      knots: many\n", 4,
+              "per_method.imu_input.window.knots");
+  // A value that parses but is invalid for the method it overrides.
+  EXPECT_THROW(LoadOdometryConfig(
+                   WriteTemp("pm_bad.yaml", "per_method:\n  imu_input:\n    window: {knots: 1}\n")),
+               std::runtime_error);
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp("pm_seq.yaml", "per_method: [imu_input]\n")),
+               std::runtime_error);
+}
+
+}  // namespace
+}  // namespace ctlio::lio
