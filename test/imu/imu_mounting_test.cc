@@ -9,10 +9,10 @@
 #include <random>
 
 #include "common/gradient_check.h"
-#include "imu/imu_test_blocks.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/manifolds/rotation_manifold.h"
+#include "imu/imu_test_blocks.h"
 
 namespace ctlio::imu {
 namespace {
@@ -163,18 +163,7 @@ TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {
   const Mat3 A = Mat3::Random();
   const Mat3 cov = 1e-3 * (A * A.transpose() + Mat3::Identity());
   for (int trial = 0; trial < 6; ++trial) {
-    const double angle = trial < 2 ? 1.0 : (trial < 4 ? 3.1 : 1e-7);
-    const double scale = trial < 4 ? 1.0 : 1e-6;
-    KnotState k, k1;
-    k.pose = testing::RandomPose(rng, angle, 5.0);
-    k1.pose = SE3::Exp(testing::RandomVec6(rng, 0.5 * scale)) * k.pose;
-    if (trial == 3) k1.pose = SE3(so3::Exp(Vec3(0, 0, 3.0)), Vec3(1, 2, 3)) * k.pose;
-    k.velocity = testing::RandomVec6(rng, 2.0);
-    k1.velocity = testing::RandomVec6(rng, 2.0);
-    k.acceleration = testing::RandomVec6(rng, 3.0);
-    k1.acceleration = testing::RandomVec6(rng, 3.0);
-    const Blocks blocks(k, k1, testing::RandomVec6(rng, 0.1), testing::RandomVec6(rng, 0.1),
-                        testing::RandomPose(rng, 2.0, 0.0).rotation());
+    const Blocks blocks = testing::JacobianCheckBlocks(rng, trial);
     ImuMounting mounting = RandomMounting(rng, 0.6);
     if (trial == 2) mounting.C_ri = so3::Exp(Vec3(0, 3.14159, 0));  // IMU mounted upside down
     const double t_k = 0.3, t_k1 = 0.4, tau = 0.3 + 0.1 * (trial + 0.5) / 6.0;

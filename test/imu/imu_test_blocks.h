@@ -5,8 +5,10 @@
 #include <ceres/cost_function.h>
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
+#include "common/gradient_check.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/manifolds/rotation_manifold.h"
@@ -40,6 +42,25 @@ inline Vec3 Evaluate(const ceres::CostFunction& cost, const std::vector<const do
   Vec3 r;
   EXPECT_TRUE(cost.Evaluate(params.data(), r.data(), nullptr));
   return r;
+}
+
+// Knots for the Jacobian checks of trial 0–5: generic rotations (0, 1), |φ| near π (2, 3; trial 3
+// also turns by 3 rad between the knots), near-identity with tiny motion (4, 5); random ϖ, ϖ̇,
+// biases and C_mi.
+inline Blocks JacobianCheckBlocks(std::mt19937& rng, int trial) {
+  const double angle = trial < 2 ? 1.0 : (trial < 4 ? 3.1 : 1e-7);
+  const double scale = trial < 4 ? 1.0 : 1e-6;
+  gp::KnotState k, k1;
+  k.pose = RandomPose(rng, angle, 5.0);
+  k1.pose = SE3::Exp(RandomVec6(rng, 0.5 * scale)) * k.pose;
+  if (trial == 3) k1.pose = SE3(so3::Exp(Vec3(0, 0, 3.0)), Vec3(1, 2, 3)) * k.pose;
+  k.velocity = RandomVec6(rng, 2.0);
+  k1.velocity = RandomVec6(rng, 2.0);
+  k.acceleration = RandomVec6(rng, 3.0);
+  k1.acceleration = RandomVec6(rng, 3.0);
+  const Vec6 b_k = RandomVec6(rng, 0.1);
+  const Vec6 b_k1 = RandomVec6(rng, 0.1);
+  return Blocks(k, k1, b_k, b_k1, RandomPose(rng, 2.0, 0.0).rotation());
 }
 
 }  // namespace ctlio::testing
