@@ -95,7 +95,7 @@ PointCloud FromRaw(const detail::RawCloud& c, const std::string& path, const Rea
       int64_t t = 0;
       if (!PointTimeNs(layout, c.data.data() + i * c.point_step, options.stamp_ns, &t)) {
         throw UnusableCloudError(path + ": point " + std::to_string(i) +
-                                 ": time is not finite or outside int64 ns");
+                                 ": time is not a valid time (not finite or outside int64 ns)");
       }
       out.times_ns.push_back(t);
     }
