@@ -265,8 +265,9 @@ int main(int argc, char** argv) {
   google::InitGoogleLogging(argv[0]);
   // A fit or evaluation window without positions (10 Hz) has nothing to fit or evaluate.
   if (!(FLAGS_fit_seconds >= 1.0) || !(FLAGS_eval_seconds == 0.0 || FLAGS_eval_seconds >= 1.0)) {
-    std::fprintf(stderr, "euroc_fusion: --fit_seconds must be >= 1 s and --eval_seconds 0 (whole "
-                         "second half) or >= 1 s\n");
+    std::fprintf(stderr,
+                 "euroc_fusion: --fit_seconds must be >= 1 s and --eval_seconds 0 (whole "
+                 "second half) or >= 1 s\n");
     return 2;
   }
   try {

@@ -161,10 +161,9 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
                          const std::string& world, const ctlio::sim::SimConfig& shared) {
   std::ostringstream s;
   s << "preset " << preset << "\nworld " << world << "\nduration_s " << shared.duration_s
-    << "\nbeams " << shared.lidar.beams << "\nfiring_decimation "
-    << shared.lidar.firing_decimation << "\nimu_model "
-    << (shared.imu.body_centric ? "body-centric" : "exact-specific-force") << "\nconfig "
-    << std::filesystem::path(config_path).filename().string() << "\nfailure_ate_m "
+    << "\nbeams " << shared.lidar.beams << "\nfiring_decimation " << shared.lidar.firing_decimation
+    << "\nimu_model " << (shared.imu.body_centric ? "body-centric" : "exact-specific-force")
+    << "\nconfig " << std::filesystem::path(config_path).filename().string() << "\nfailure_ate_m "
     << FLAGS_failure_ate << "\n";
   return s.str();
 }
@@ -201,13 +200,12 @@ void WriteTable(const std::string& out, const std::string& settings,
   std::ostringstream md;
   const std::string preset = kv.count("preset") ? kv.at("preset") : "none";
   md << "# Table II (ctlio): RMSE ATE [m] per regime, method and scenario, world " << kv.at("world")
-     << (preset == "none" ? "" : ", preset " + preset) << "\n\nSettings: " << per_regime << " sequences per regime (indices " << lo << "–" << hi
-     << "), " << kv.at("duration_s") << " s each, " << kv.at("beams")
-     << " beams, firing decimation " << kv.at("firing_decimation") << ", " << kv.at("imu_model")
-     << " IMU, config " << kv.at("config") << ". ";
-  const bool full = preset == "none" && per_regime >= 20 &&
-                    std::stod(kv.at("duration_s")) >= 20 && std::stoi(kv.at("beams")) >= 128 &&
-                    kv.at("firing_decimation") == "1";
+     << (preset == "none" ? "" : ", preset " + preset) << "\n\nSettings: " << per_regime
+     << " sequences per regime (indices " << lo << "–" << hi << "), " << kv.at("duration_s")
+     << " s each, " << kv.at("beams") << " beams, firing decimation " << kv.at("firing_decimation")
+     << ", " << kv.at("imu_model") << " IMU, config " << kv.at("config") << ". ";
+  const bool full = preset == "none" && per_regime >= 20 && std::stod(kv.at("duration_s")) >= 20 &&
+                    std::stoi(kv.at("beams")) >= 128 && kv.at("firing_decimation") == "1";
   md << (preset != "none" ? "Preset settings.\n\n"
          : full           ? "Full paper settings.\n\n"
                           : "**REDUCED settings** (not the paper's 20 × 20 s × 128 beams).\n\n");

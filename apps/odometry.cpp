@@ -44,8 +44,8 @@
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
-#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/sim/presets.h"
+#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/yaml_io.h"
 #include "lio/run_odometry.h"
@@ -255,9 +255,9 @@ int main(int argc, char** argv) {
          << "\nmedian_solve_ms " << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
          << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
          << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin
-         << "\"\nimu_samples_rejected " << run.imu_rejected
-         << "\npoints_dropped_out_of_interval " << run.points_dropped << "\nscans_skipped "
-         << run.scans_skipped << "\nconstant_imu_scans " << run.constant_imu_scans << "\n";
+         << "\"\nimu_samples_rejected " << run.imu_rejected << "\npoints_dropped_out_of_interval "
+         << run.points_dropped << "\nscans_skipped " << run.scans_skipped << "\nconstant_imu_scans "
+         << run.constant_imu_scans << "\n";
       if (!run.first_input_warning.empty()) {
         ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
       }

@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
   }
   fuzz::QuietLogging();
   const fs::path corpus(argv[1]), source_dir(argv[2]);
-  const fs::path work = fs::temp_directory_path() / ("ctlio_fuzz_seeds_" + std::to_string(getpid()));
+  const fs::path work =
+      fs::temp_directory_path() / ("ctlio_fuzz_seeds_" + std::to_string(getpid()));
   fs::remove_all(work);
   try {
     sim::SimulatedSource a(Tiny()), b(Tiny());
@@ -73,8 +74,8 @@ int main(int argc, char** argv) {
          Join({Read(n / "raw_format/ouster_imu/data.csv"),
                Read(n / "ground_truth/registered_poses.csv"), pcd0, pcd1}));
     Seed(corpus, "pcd", "binary", pcd0);
-    const io::PointCloud cloud = io::ReadPcd((scans / "cloud_1583836591_182590000.pcd").string(),
-                                             {Tiny().start_ns, true});
+    const io::PointCloud cloud =
+        io::ReadPcd((scans / "cloud_1583836591_182590000.pcd").string(), {Tiny().start_ns, true});
     std::ostringstream ascii;
     ascii << "VERSION .7\nFIELDS x y z intensity t ring\nSIZE 4 4 4 4 4 2\nTYPE F F F F U U\n"
           << "COUNT 1 1 1 1 1 1\nWIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
@@ -98,8 +99,7 @@ int main(int argc, char** argv) {
     Seed(corpus, "trajectory", "kitti", Join({Read(work / "poses.txt"), times}));
     Seed(corpus, "kitti_folder", "sim",
          Join({"0.0\n0.1\n", Read(work / "s.bin"), Read(work / "s.bin"), Read(work / "s_times.bin"),
-               Read(work / "poses.txt"),
-               "Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"}));
+               Read(work / "poses.txt"), "Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"}));
     for (const auto& e : fs::directory_iterator(source_dir / "data")) {
       if (e.path().extension() == ".yaml") {
         Seed(corpus, "yaml_config", e.path().filename().string(), Read(e.path()));

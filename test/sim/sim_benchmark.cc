@@ -34,8 +34,8 @@ BENCHMARK(BM_Scan)->Unit(benchmark::kMillisecond);
 // (guided along the path outside the box), sequence 0, scans taken in turn over the first 5 s.
 void BM_ScanWorld(benchmark::State& state) {
   const auto world = static_cast<ctlio::sim::WorldKind>(state.range(0));
-  ctlio::sim::SimConfig c = ctlio::sim::ExperimentConfig(
-      ctlio::sim::Regime::kMedium, 0, ctlio::sim::kExperimentSeed, world);
+  ctlio::sim::SimConfig c = ctlio::sim::ExperimentConfig(ctlio::sim::Regime::kMedium, 0,
+                                                         ctlio::sim::kExperimentSeed, world);
   c.duration_s = 5.0;
   const ctlio::sim::LidarInertialSim sim(c);
   size_t k = 0, points = 0;

@@ -38,15 +38,32 @@ std::vector<PointField> LayoutFields(const detail::RawCloud& c) {
   for (const detail::FieldDesc& f : c.fields) {
     uint8_t code = 0;
     switch (f.type) {
-      case detail::ScalarType::kInt8: code = kInt8; break;
-      case detail::ScalarType::kUint8: code = kUInt8; break;
-      case detail::ScalarType::kInt16: code = kInt16; break;
-      case detail::ScalarType::kUint16: code = kUInt16; break;
-      case detail::ScalarType::kInt32: code = kInt32; break;
-      case detail::ScalarType::kUint32: code = kUInt32; break;
-      case detail::ScalarType::kFloat32: code = kFloat32; break;
-      case detail::ScalarType::kFloat64: code = kFloat64; break;
-      default: break;
+      case detail::ScalarType::kInt8:
+        code = kInt8;
+        break;
+      case detail::ScalarType::kUint8:
+        code = kUInt8;
+        break;
+      case detail::ScalarType::kInt16:
+        code = kInt16;
+        break;
+      case detail::ScalarType::kUint16:
+        code = kUInt16;
+        break;
+      case detail::ScalarType::kInt32:
+        code = kInt32;
+        break;
+      case detail::ScalarType::kUint32:
+        code = kUInt32;
+        break;
+      case detail::ScalarType::kFloat32:
+        code = kFloat32;
+        break;
+      case detail::ScalarType::kFloat64:
+        code = kFloat64;
+        break;
+      default:
+        break;
     }
     out.push_back({f.name, code, uint32_t(f.offset), uint32_t(f.count)});
   }
@@ -62,9 +79,9 @@ PointCloud FromRaw(const detail::RawCloud& c, const std::string& path, const Rea
   const std::vector<PointField> fields = LayoutFields(c);
   PointLayout layout;
   try {
-    layout = DetectPointLayout(fields, uint32_t(c.point_step),
-                               options.time ? *options.time : TimeFieldOptions{},
-                               path + ": " + where);
+    layout =
+        DetectPointLayout(fields, uint32_t(c.point_step),
+                          options.time ? *options.time : TimeFieldOptions{}, path + ": " + where);
   } catch (const std::exception& e) {
     // A time field of a type no driver writes: the file is well formed but not a timed scan.
     throw UnusableCloudError(e.what());

@@ -118,7 +118,8 @@ NavStateEstimator::DeskewTable NavStateEstimator::Deskew(const State& from, cons
 
 std::string NavStateEstimator::ImuGapRecovery() const {
   if (config_.gap_zero_order_hold) return "bridged by holding the last sample";
-  return "held over holes up to imu.gap_hold_max; longer ones not preintegrated: constant-twist prediction, lidar-only registration, velocity random "
+  return "held over holes up to imu.gap_hold_max; longer ones not preintegrated: constant-twist "
+         "prediction, lidar-only registration, velocity random "
          "walk; the preintegration restarts from the estimate when the IMU returns";
 }
 
