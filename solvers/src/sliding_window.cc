@@ -144,7 +144,11 @@ double* SlidingWindow::AddVectorState(StateId id, const Eigen::VectorXd& v) {
 
 void SlidingWindow::RemoveState(StateId id) {
   StateBlock& block = Get(id, __LINE__);
-  const std::set<ceres::ResidualBlockId> residuals = block.residuals;
+  std::vector<ceres::ResidualBlockId> residuals(block.residuals.begin(), block.residuals.end());
+  std::sort(residuals.begin(), residuals.end(),
+            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
+              return residual_serial_.at(a) < residual_serial_.at(b);
+            });
   for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
   problem_->RemoveParameterBlock(block.values.get());
   states_.erase(id);
@@ -217,6 +221,7 @@ ceres::ResidualBlockId SlidingWindow::AddResidualBlock(ceres::CostFunction* cost
   }
   const ceres::ResidualBlockId id = problem_->AddResidualBlock(cost, loss, blocks);
   residuals_.emplace(id, states);
+  residual_serial_.emplace(id, next_residual_serial_++);
   for (StateId s : states) states_.at(s).residuals.insert(id);
   return id;
 }
@@ -226,6 +231,7 @@ void SlidingWindow::RemoveResidualBlock(ceres::ResidualBlockId id) {
   if (it == residuals_.end()) Throw(__LINE__, "unknown residual block");
   for (StateId s : it->second) states_.at(s).residuals.erase(id);
   residuals_.erase(it);
+  residual_serial_.erase(id);
   problem_->RemoveResidualBlock(id);
 }
 
@@ -407,6 +413,13 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
   }
   report.kept.assign(kept.begin(), kept.end());
   report.removed_residual_blocks = static_cast<int>(residual_set.size());
+  // In the order they were added (not by address): the linearisation's sums and Ceres' residual
+  // order after the removals below then do not depend on the heap layout.
+  std::vector<ceres::ResidualBlockId> residuals(residual_set.begin(), residual_set.end());
+  std::sort(residuals.begin(), residuals.end(),
+            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
+              return residual_serial_.at(a) < residual_serial_.at(b);
+            });
 
   // Everything that can throw happens before the window changes.
   Eigen::MatrixXd sqrt_information;
@@ -416,7 +429,6 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
     ordering.insert(ordering.end(), report.kept.begin(), report.kept.end());
     Eigen::MatrixXd H;
     Eigen::VectorXd b;
-    const std::vector<ceres::ResidualBlockId> residuals(residual_set.begin(), residual_set.end());
     Linearize(residuals, ordering, &H, &b);
     const SchurComplementResult schur = SchurComplementLeading(
         H, b, report.marginalized_dimension, options_.relative_eigenvalue_threshold);
@@ -440,7 +452,7 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
     prior = std::make_unique<MarginalizationPrior>(manifolds, sizes, points, sqrt_information, r0);
   }
 
-  for (ceres::ResidualBlockId r : residual_set) RemoveResidualBlock(r);
+  for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
   for (StateId id : leaving) {
     problem_->RemoveParameterBlock(states_.at(id).values.get());
     states_.erase(id);

@@ -159,6 +159,10 @@ class SlidingWindow {
   std::unique_ptr<ceres::Problem> problem_;
   std::map<StateId, StateBlock> states_;
   std::unordered_map<ceres::ResidualBlockId, std::vector<StateId>> residuals_;
+  // Order in which the residual blocks were added: Marginalize sums their linearisations in this
+  // order, not in the order of their addresses, so that its result does not depend on the heap.
+  std::unordered_map<ceres::ResidualBlockId, uint64_t> residual_serial_;
+  uint64_t next_residual_serial_ = 0;
 };
 
 }  // namespace ctlio
