@@ -20,13 +20,8 @@ namespace {
 using gp::KnotState;
 using gp::SingerModel;
 
-SingerModel<6> Wnoj() { return SingerModel<6>::Wnoj(Vec6::Constant(1.0)); }
-SingerModel<6> Singer() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0.5, 0.5, 0.5, 100, 100, 100;
-  return SingerModel<6>(qc, alpha);
-}
+using ::ctlio::testing::Singer;
+using ::ctlio::testing::Wnoj;
 
 using ::ctlio::testing::Blocks;
 using ::ctlio::testing::Evaluate;

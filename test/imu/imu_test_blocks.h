@@ -1,4 +1,4 @@
-// Parameter storage shared by the IMU-measurement tests: the blocks of two GP knots, their biases
+// Shared by the IMU-measurement tests: the priors, and the blocks of two GP knots, their biases
 // and the gravity rotation C_mi, in the order ImuGyroMeasurement / ImuAccelMeasurement take them.
 #pragma once
 
@@ -10,10 +10,21 @@
 
 #include "common/gradient_check.h"
 #include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/motion_model.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/manifolds/rotation_manifold.h"
 
 namespace ctlio::testing {
+
+// The two priors the IMU tests run every check under: WNOJ with Qc = 1, and a Singer prior with
+// the Newer College α on rotation (SPEC §4).
+inline gp::SingerModel<6> Wnoj() { return gp::SingerModel<6>::Wnoj(Vec6::Constant(1.0)); }
+inline gp::SingerModel<6> Singer() {
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0.5, 0.5, 0.5, 100, 100, 100;
+  return gp::SingerModel<6>(qc, alpha);
+}
 
 struct Blocks {
   double pose_k[7], vel_k[6], acc_k[6], pose_k1[7], vel_k1[6], acc_k1[6], b_k[6], b_k1[6], q_mi[4];

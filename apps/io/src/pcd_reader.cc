@@ -23,21 +23,6 @@ constexpr size_t kMaxPoints = (size_t(1) << 31) - 1;  // PCD stores WIDTH as uin
 constexpr size_t kMaxCount = size_t(1) << 16;         // elements per field
 constexpr size_t kMaxPointStep = size_t(1) << 20;     // bytes per point record
 
-[[noreturn]] void Fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error(path + ": " + what);
-}
-[[noreturn]] void FailLine(const std::string& path, int line, const std::string& what) {
-  Fail(path, "line " + std::to_string(line) + ": " + what);
-}
-
-std::vector<std::string> Tokens(const std::string& line) {
-  std::istringstream ss(line);
-  std::vector<std::string> out;
-  std::string t;
-  while (ss >> t) out.push_back(t);
-  return out;
-}
-
 // A non-negative decimal integer no larger than `max`.
 size_t ParseCount(const std::string& path, int line, const std::string& tok, size_t max) {
   if (tok.empty() || tok.size() > 18 || tok.find_first_not_of("0123456789") != std::string::npos) {
@@ -295,13 +280,7 @@ void ReadCompressedData(const std::string& path, const std::vector<char>& bytes,
 }  // namespace
 
 RawCloud ReadPcdRaw(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) Fail(path, "file not found");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Fail(path, "cannot open");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
-                                std::istreambuf_iterator<char>());
-  if (in.bad()) Fail(path, "read error");
+  const std::vector<char> bytes = ReadFileBytes(path);
   size_t pos = 0;
   Header h = ParseHeader(path, bytes, &pos);
   RawCloud& c = h.cloud;

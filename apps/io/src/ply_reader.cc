@@ -18,21 +18,6 @@ namespace {
 constexpr size_t kMaxVertices = (size_t(1) << 31) - 1;
 constexpr size_t kMaxProperties = 1024;
 
-[[noreturn]] void Fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error(path + ": " + what);
-}
-[[noreturn]] void FailLine(const std::string& path, int line, const std::string& what) {
-  Fail(path, "line " + std::to_string(line) + ": " + what);
-}
-
-std::vector<std::string> Tokens(const std::string& line) {
-  std::istringstream ss(line);
-  std::vector<std::string> out;
-  std::string t;
-  while (ss >> t) out.push_back(t);
-  return out;
-}
-
 bool PlyType(const std::string& name, ScalarType* type) {
   static const std::map<std::string, ScalarType> kTypes = {
       {"char", ScalarType::kInt8},      {"int8", ScalarType::kInt8},
@@ -52,12 +37,7 @@ bool PlyType(const std::string& name, ScalarType* type) {
 }  // namespace
 
 RawCloud ReadPlyRaw(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) Fail(path, "file not found");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) Fail(path, "cannot open");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
-                                std::istreambuf_iterator<char>());
+  const std::vector<char> bytes = ReadFileBytes(path);
   size_t pos = 0;
   int n = 0;
   auto next_line = [&](std::string* line) {

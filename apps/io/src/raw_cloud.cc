@@ -4,7 +4,12 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <sstream>
+#include <stdexcept>
 
 namespace ctlio::io::detail {
 namespace {
@@ -147,6 +152,32 @@ bool ReadAsInt64(const RawCloud& c, size_t i, const FieldDesc& f, int64_t* value
     *value = int64_t(ReadAsDouble(c, i, f));  // exact for every type up to 32 bits
   }
   return true;
+}
+
+void Fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error(path + ": " + what);
+}
+
+void FailLine(const std::string& path, int line, const std::string& what) {
+  Fail(path, "line " + std::to_string(line) + ": " + what);
+}
+
+std::vector<std::string> Tokens(const std::string& line) {
+  std::istringstream ss(line);
+  std::vector<std::string> out;
+  std::string t;
+  while (ss >> t) out.push_back(t);
+  return out;
+}
+
+std::vector<char> ReadFileBytes(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) Fail(path, "file not found");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) Fail(path, "cannot open");
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) Fail(path, "read error");
+  return bytes;
 }
 
 }  // namespace ctlio::io::detail

@@ -49,6 +49,14 @@ double ReadAsDouble(const RawCloud& cloud, size_t i, const FieldDesc& f, size_t 
 // Reads an integer field exactly; false for a float field or a uint64 value above INT64_MAX.
 bool ReadAsInt64(const RawCloud& cloud, size_t i, const FieldDesc& f, int64_t* value);
 
+// The readers' shared pieces: "<path>: <what>" and "<path>: line N: <what>" errors, the
+// whitespace-separated tokens of a header line, and a whole file's bytes ("file not found",
+// "cannot open" and "read error" name the path).
+[[noreturn]] void Fail(const std::string& path, const std::string& what);
+[[noreturn]] void FailLine(const std::string& path, int line, const std::string& what);
+std::vector<std::string> Tokens(const std::string& line);
+std::vector<char> ReadFileBytes(const std::string& path);
+
 // Writes the ascii token `tok` as a value of `type` at `out`; false if it does not parse or does
 // not fit the type (an integer field holding "nan", or 300 in a uint8, is malformed).
 bool StoreAsciiValue(const std::string& tok, ScalarType type, uint8_t* out);
