@@ -403,6 +403,9 @@ int main(int argc, char** argv) {
       r.max_ms = j.run.max_ms;
       r.median_cpu_ms = j.run.median_cpu_ms;
       r.p95_cpu_ms = j.run.p95_cpu_ms;
+      r.drift_m_per_100m = j.done && j.run.drift_per_100m ? *j.run.drift_per_100m : NAN;
+      r.scans = static_cast<int>(j.run.scans.size());
+      r.degenerate_direction_scans = j.run.degenerate_direction_scans;
       r.error = j.error;
       rows.push_back(r);
     }

@@ -12,7 +12,8 @@
 //
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
 // --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
-// DIR/scans.log (one line per scan: status, residual counts, iterations, time) and, when the
+// DIR/scans.log (one line per scan: status, residual counts, iterations, time, the degenerate
+// directions of the lidar term: README "Degeneracy") and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
 // alignment) and DIR/pose_errors.csv. Plots (tools/plot_odometry.py, python3-matplotlib):
 // DIR/odometry.png (top and side view in metres, errors and per-scan time/status over time) and,
@@ -248,11 +249,12 @@ int main(int argc, char** argv) {
       std::ofstream ev = io::OpenForWriting(ev_path);
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
          << "\nfailed_scans " << run.failed << "\ndegenerate_scans " << run.degenerate
-         << "\nimu_gap_scans " << run.imu_gaps << "\nmedian_ms " << run.median_ms << "\np95_ms "
-         << run.p95_ms << "\nmax_ms " << run.max_ms << "\nmedian_cpu_ms " << run.median_cpu_ms
-         << "\np95_cpu_ms " << run.p95_cpu_ms << "\nmedian_preprocess_ms "
-         << run.median_preprocess_ms << "\nmedian_associate_ms " << run.median_associate_ms
-         << "\nmedian_solve_ms " << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
+         << "\ndegenerate_direction_scans " << run.degenerate_direction_scans << "\nimu_gap_scans "
+         << run.imu_gaps << "\nmedian_ms " << run.median_ms << "\np95_ms " << run.p95_ms
+         << "\nmax_ms " << run.max_ms << "\nmedian_cpu_ms " << run.median_cpu_ms << "\np95_cpu_ms "
+         << run.p95_cpu_ms << "\nmedian_preprocess_ms " << run.median_preprocess_ms
+         << "\nmedian_associate_ms " << run.median_associate_ms << "\nmedian_solve_ms "
+         << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
          << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
          << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin
          << "\"\nimu_samples_rejected " << run.imu_rejected << "\npoints_dropped_out_of_interval "
@@ -321,6 +323,10 @@ int main(int argc, char** argv) {
           "  map %.1f  marginalise %.1f\n",
           r.method.c_str(), r.median_preprocess_ms, r.median_associate_ms, r.median_solve_ms,
           r.median_map_ms, r.median_marginalize_ms);
+      std::printf("  %-10s drift per 100 m: %s m; scans with degenerate directions: %d of %zu\n",
+                  r.method.c_str(),
+                  r.drift_per_100m ? std::to_string(*r.drift_per_100m).c_str() : "-",
+                  r.degenerate_direction_scans, r.scans.size());
     }
     int bad = 0;
     for (const auto& r : runs) bad += r.failure ? 1 : 0;

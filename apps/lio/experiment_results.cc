@@ -18,8 +18,9 @@ namespace {
 
 const char* kHeader =
     "regime,sequence,method,scenario,ate_rmse_m,ate_pairs,failed_scans,degenerate_scans,"
-    "imu_gap_scans,failure,median_ms,p95_ms,max_ms,median_cpu_ms,p95_cpu_ms,error";
-constexpr int kFields = 16;
+    "imu_gap_scans,failure,median_ms,p95_ms,max_ms,median_cpu_ms,p95_cpu_ms,drift_m_per_100m,"
+    "scans,degenerate_direction_scans,error";
+constexpr int kFields = 19;
 
 // Position of `key` in `order`, appended when new: the order of first appearance.
 void Remember(std::vector<std::string>* order, const std::string& key) {
@@ -50,7 +51,8 @@ void WriteResultsCsv(const std::string& path, const std::vector<RunRow>& rows) {
     f << r.regime << ',' << r.sequence << ',' << r.method << ',' << r.scenario << ','
       << r.ate_rmse_m << ',' << r.ate_pairs << ',' << r.failed_scans << ',' << r.degenerate_scans
       << ',' << r.imu_gap_scans << ',' << (r.failure ? 1 : 0) << ',' << r.median_ms << ','
-      << r.p95_ms << ',' << r.max_ms << ',' << r.median_cpu_ms << ',' << r.p95_cpu_ms << ",\""
+      << r.p95_ms << ',' << r.max_ms << ',' << r.median_cpu_ms << ',' << r.p95_cpu_ms << ','
+      << r.drift_m_per_100m << ',' << r.scans << ',' << r.degenerate_direction_scans << ",\""
       << error << "\"\n";
   }
   io::CloseChecked(f, path);
@@ -98,6 +100,9 @@ std::vector<RunRow> ReadResultsCsv(const std::string& path) {
     r.max_ms = ParseDouble(v[12], where);
     r.median_cpu_ms = ParseDouble(v[13], where);
     r.p95_cpu_ms = ParseDouble(v[14], where);
+    r.drift_m_per_100m = ParseDouble(v[15], where);
+    r.scans = static_cast<int>(ParseDouble(v[16], where));
+    r.degenerate_direction_scans = static_cast<int>(ParseDouble(v[17], where));
     error = error.substr(1, error.size() - 2);
     for (size_t i = 0; i < error.size(); ++i) {
       r.error += error[i];
@@ -120,13 +125,20 @@ std::vector<PooledCell> PoolRows(const std::vector<RunRow>& rows) {
     for (const auto& scenario : scenarios) {
       for (const auto& method : methods) {
         PooledCell c{regime, method, scenario};
-        double s_ok = 0, n_ok = 0, s_all = 0, n_all = 0;
+        double s_ok = 0, n_ok = 0, s_all = 0, n_all = 0, drift_sum = 0, drift_n = 0;
         std::vector<double> med, p95, cpu;
         for (const RunRow& r : rows) {
           if (r.regime != regime || r.method != method || r.scenario != scenario) continue;
           ++c.runs;
           if (r.failure) ++c.failures;
           if (!r.error.empty()) continue;
+          c.scans += r.scans;
+          c.degenerate_scans += r.degenerate_scans;
+          c.degenerate_direction_scans += r.degenerate_direction_scans;
+          if (!r.failure && std::isfinite(r.drift_m_per_100m)) {
+            drift_sum += r.drift_m_per_100m;
+            ++drift_n;
+          }
           const double n = double(r.ate_pairs);
           const double e2 = r.ate_rmse_m * r.ate_rmse_m;
           if (n > 0 && std::isfinite(e2)) {
@@ -144,6 +156,7 @@ std::vector<PooledCell> PoolRows(const std::vector<RunRow>& rows) {
         if (c.runs == 0) continue;
         c.rmse_ok = n_ok > 0 ? std::sqrt(s_ok / n_ok) : NAN;
         c.rmse_all = n_all > 0 ? std::sqrt(s_all / n_all) : NAN;
+        c.drift_ok = drift_n > 0 ? drift_sum / drift_n : NAN;
         c.median_ms = Percentile(med, 0.5);
         c.p95_ms = Percentile(p95, 0.5);
         c.median_cpu_ms = Percentile(cpu, 0.5);
@@ -157,14 +170,17 @@ std::vector<PooledCell> PoolRows(const std::vector<RunRow>& rows) {
 std::string PooledTableMarkdown(const std::vector<PooledCell>& cells) {
   std::ostringstream md;
   md << "| regime | method | scenario | runs | RMSE ATE (non-failed) [m] | RMSE ATE (all) [m] | "
-        "failures | median ms/scan (wall) | p95 ms/scan (wall) | median CPU ms/scan |\n"
-        "|---|---|---|---|---|---|---|---|---|---|\n";
+        "drift per 100 m (non-failed, mean) [m] | failures | scans degenerate / with degenerate "
+        "directions / all | median ms/scan (wall) | p95 ms/scan (wall) | median CPU ms/scan |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PooledCell& c : cells) {
-    char line[320];
+    char line[400];
     std::snprintf(line, sizeof(line),
-                  "| %s | %s | %s | %d | %.4f | %.4f | %d | %.1f | %.1f | %.1f |\n",
+                  "| %s | %s | %s | %d | %.4f | %.4f | %.3f | %d | %d / %d / %d | %.1f | %.1f | "
+                  "%.1f |\n",
                   c.regime.c_str(), c.method.c_str(), c.scenario.c_str(), c.runs, c.rmse_ok,
-                  c.rmse_all, c.failures, c.median_ms, c.p95_ms, c.median_cpu_ms);
+                  c.rmse_all, c.drift_ok, c.failures, c.degenerate_scans,
+                  c.degenerate_direction_scans, c.scans, c.median_ms, c.p95_ms, c.median_cpu_ms);
     md << line;
   }
   return md.str();
@@ -172,11 +188,13 @@ std::string PooledTableMarkdown(const std::vector<PooledCell>& cells) {
 
 void WritePooledCsv(const std::string& path, const std::vector<PooledCell>& cells) {
   std::ofstream f = io::OpenForWriting(path);
-  f << "regime,method,scenario,runs,failures,rmse_ate_non_failed_m,rmse_ate_all_m\n";
+  f << "regime,method,scenario,runs,failures,rmse_ate_non_failed_m,rmse_ate_all_m,"
+       "drift_m_per_100m_non_failed,scans,degenerate_scans,degenerate_direction_scans\n";
   for (const PooledCell& c : cells) {
-    char line[320];
-    std::snprintf(line, sizeof(line), "%s,%s,%s,%d,%d,%.6g,%.6g\n", c.regime.c_str(),
-                  c.method.c_str(), c.scenario.c_str(), c.runs, c.failures, c.rmse_ok, c.rmse_all);
+    char line[400];
+    std::snprintf(line, sizeof(line), "%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%d,%d,%d\n", c.regime.c_str(),
+                  c.method.c_str(), c.scenario.c_str(), c.runs, c.failures, c.rmse_ok, c.rmse_all,
+                  c.drift_ok, c.scans, c.degenerate_scans, c.degenerate_direction_scans);
     f << line;
   }
   io::CloseChecked(f, path);

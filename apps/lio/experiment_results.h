@@ -21,6 +21,10 @@ struct RunRow {
   int failed_scans = 0, degenerate_scans = 0, imu_gap_scans = 0;
   bool failure = false;
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0, median_cpu_ms = 0.0, p95_cpu_ms = 0.0;
+  // RunSummary::drift_per_100m (NaN without one), the scans run and those with a degenerate
+  // direction of the lidar term (lio/degeneracy.h).
+  double drift_m_per_100m = 0.0;
+  int scans = 0, degenerate_direction_scans = 0;
   std::string error;
 };
 
@@ -39,6 +43,9 @@ struct PooledCell {
   // and over all runs.
   double rmse_ok = 0.0, rmse_all = 0.0;
   double median_ms = 0.0, p95_ms = 0.0, median_cpu_ms = 0.0;  // medians over the runs
+  double drift_ok = 0.0;  // mean drift per 100 m [m] over the runs that did not fail
+  // Summed over the runs: scans, scans reported `degenerate`, scans with a degenerate direction.
+  int scans = 0, degenerate_scans = 0, degenerate_direction_scans = 0;
 };
 
 // Cells in the order regimes × scenarios × methods of first appearance in `rows`.

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 
@@ -90,6 +91,24 @@ AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
   r.rmse = std::sqrt(sum2 / double(est.size()));
   r.mean /= double(est.size());
   return r;
+}
+
+std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
+                                   const std::vector<io::StampedPose>& truth) {
+  std::vector<io::StampedPose> est, ref;
+  for (const io::StampedPose& e : estimate) {
+    Vec3 p;
+    Mat3 C;
+    if (!TruthAt(truth, e.t_ns, &p, &C)) continue;
+    est.push_back(e);
+    ref.push_back({e.t_ns, SE3(C, p)});
+  }
+  double path = 0.0;
+  for (size_t i = 1; i < ref.size(); ++i) {
+    path += (ref[i].pose.translation() - ref[i - 1].pose.translation()).norm();
+  }
+  if (path < 1.0) return std::nullopt;
+  return eval::ComputeRpeDistance(est, ref, std::min(kDriftWindow, 0.5 * path)).translation_percent;
 }
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
@@ -212,6 +231,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       default:
         break;
     }
+    if (r.degeneracy.num_degenerate() > 0) ++run.degenerate_direction_scans;
     if (r.status != lio::ScanStatus::kFailed) {
       run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
       if (options.trajectory_rate_hz > 0.0) {
@@ -253,6 +273,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     // No ATE where there is no estimate to evaluate (e.g. every scan failed initialisation).
     const AteResult ate = EvaluateAte(run.trajectory, *truth);
     if (ate.pairs >= 3) run.ate = ate;
+    run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
   }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
@@ -338,7 +359,8 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
 void WriteScanLog(const std::string& path, const RunSummary& run) {
   std::ofstream f = io::OpenForWriting(path);
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
-       "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z message\n";
+       "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z "
+       "degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info degen_prior_info message\n";
   f << std::setprecision(12);
   for (size_t i = 0; i < run.scans.size(); ++i) {
     const lio::ScanResult& r = run.scans[i];
@@ -348,8 +370,20 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
       << ' ' << r.keypoints << ' ' << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds
       << ' ' << r.solver_iterations << ' ' << r.final_cost << ' ' << r.milliseconds << ' '
       << r.ms_preprocess << ' ' << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' '
-      << r.ms_marginalize << ' ' << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
-      << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+      << r.ms_marginalize << ' ' << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ';
+    const lio::DegeneracyReport& d = r.degeneracy;
+    if (d.analysed) {
+      f << d.translation_eigenvalues[0] << ' ' << d.rotation_eigenvalues[0] << ' '
+        << d.num_degenerate() << ' ' << d.DirectionString() << ' ';
+      if (d.num_degenerate() > 0) {
+        f << d.lidar_information << ' ' << d.prior_information << ' ';
+      } else {
+        f << "- - ";
+      }
+    } else {
+      f << "- - - - - - ";
+    }
+    f << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
   io::CloseChecked(f, path);
 }

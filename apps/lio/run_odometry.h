@@ -50,6 +50,9 @@ struct RunSummary {
   std::vector<io::StampedPose> dense;
   std::vector<lio::ScanResult> scans;
   int failed = 0, degenerate = 0, imu_gaps = 0;
+  // Scans whose lidar term had at least one degenerate direction (lio/degeneracy.h), whatever
+  // their status (with an IMU they stay `ok`: the IMU and the prior carry those directions).
+  int degenerate_direction_scans = 0;
   std::string first_failure;  // message of the first failed scan
   // Input gates (lio/input_checks.h): samples rejected, points dropped for their time, scans
   // skipped (end not after the previous one), scans estimated with a frozen IMU while the lidar
@@ -64,10 +67,16 @@ struct RunSummary {
          median_map_ms = 0.0, median_marginalize_ms = 0.0;
   long peak_rss_kb = 0;          // process-wide high-water mark (getrusage ru_maxrss) at the end
   std::optional<AteResult> ate;  // when the source has ground truth and ≥ 3 estimates pair with it
+  // Drift per 100 m [m]: the mean relative translation error over windows of kDriftWindow m of
+  // ground-truth path (half the path when shorter), per 100 m (ctlio::eval RPE over distance,
+  // translation_percent); alignment-free. With ground truth and a path of ≥ 1 m.
+  std::optional<double> drift_per_100m;
   // The run is a failure if a scan failed after initialisation or the ATE exceeds
   // `failure_ate` (the estimate left the room of any sensible error).
   bool failure = false;
 };
+
+inline constexpr double kDriftWindow = 10.0;  // m
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options = {}, double failure_ate = 1.0);
@@ -77,6 +86,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
 AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
                       const std::vector<io::StampedPose>& truth);
 
+// RunSummary::drift_per_100m of `estimate` against `truth` (nullopt: path < 1 m).
+std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
+                                   const std::vector<io::StampedPose>& truth);
+
 // Per-pose errors against the truth after `alignment` (estimate → truth frame), CSV:
 // t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg]: the angle of
 // the rotation drift since the first pose, (C_t0ᵀ C_t)ᵀ (C_e0ᵀ C_e), with the truth rotation of the
@@ -85,8 +98,11 @@ void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
 
 // Per-scan log (the write is checked: an error names the path): t, status (or "suspect"),
-// keypoints, associations, imu residuals, rounds, solver iterations, final cost, ms, position,
-// message.
+// keypoints, associations, imu residuals, rounds, solver iterations, final cost, ms (total and
+// per stage), cpu ms, position, the degeneracy analysis (normalised smallest eigenvalue of the
+// translation and rotation blocks, number of degenerate directions, the least constrained one
+// "t:x,y,z"/"r:x,y,z" in the body frame, the lidar's and the prior's information along it; "-"
+// where not analysed), message.
 void WriteScanLog(const std::string& path, const RunSummary& run);
 
 // Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file with

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 
 namespace ctlio::lio {
@@ -136,9 +137,11 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   ReportImuGap(estimator_->newest_time(), scan.t_end, result);
   estimator_->AddState(scan, &window_, result);
 
+  const SE3 predicted = window_.Pose(estimator_->NewestPoseKey());
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
   const RegistrationSummary registered =
       registration_.Register(frontend_.map(), lidar.get(), &window_);
+  if (!registered.degenerate) AnalyseDegeneracy(registered, predicted, result);
   result->rounds = registered.rounds;
   result->solver_iterations = registered.solver_iterations;
   result->associations = registered.associations;
@@ -151,6 +154,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
     frontend_.UpdateMap(estimator_->MapPoints(scan), estimator_->NewestPose().translation());
   }
   if (registered.degenerate) ReportDegenerate(result);
+  if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
 }
@@ -244,6 +248,42 @@ void LioOdometry::ReportDegenerate(ScanResult* result) const {
                     std::to_string(config_.min_associations) +
                     "): lidar term dropped for this scan, the prior" +
                     (uses_imu() ? " and the IMU carry" : " carries") + " the state";
+}
+
+void LioOdometry::AnalyseDegeneracy(const RegistrationSummary& registered, const SE3& predicted,
+                                    ScanResult* result) {
+  const DegeneracyOptions& o = config_.degeneracy;
+  if (!o.enabled || registered.lidar_blocks.empty()) return;
+  const StateId pose = estimator_->NewestPoseKey();
+  const Mat6 A = estimator_->NewestPoseTangentFromBody();
+  DegeneracyReport& report = result->degeneracy;
+  report = lio::AnalyseDegeneracy(PoseInformation(window_, registered.lidar_blocks, pose, A), o);
+  if (report.directions.empty()) return;
+  const Vec6& u = report.directions.front();
+  report.prior_information = u.dot(OtherInformation(window_, registered.lidar_blocks, pose, A) * u);
+  if (uses_imu() || !o.remap) return;
+  // lidar_only: keep the constant-velocity prediction along the degenerate directions (solution
+  // remapping, degeneracy.h) and re-solve the other directions with it.
+  window_.AddResidualBlock(new PosePrior(predicted, RemapSqrtInformation(report, o, A)), nullptr,
+                           {pose});
+  const auto t0 = std::chrono::steady_clock::now();
+  const ceres::Solver::Summary solved = window_.Solve();
+  result->ms_solve += MsSince(t0);
+  result->solver_iterations += static_cast<int>(solved.iterations.size());
+  result->final_cost = solved.final_cost;
+  report.remapped = true;
+}
+
+void LioOdometry::ReportDegenerateDirections(ScanResult* result) const {
+  if (result->status != ScanStatus::kOk) return;
+  result->status = ScanStatus::kDegenerate;
+  result->message = std::to_string(result->degeneracy.num_degenerate()) +
+                    " degenerate direction(s) of the lidar term (least constrained " +
+                    result->degeneracy.DirectionString() + " in the body frame): no IMU to carry " +
+                    (result->degeneracy.remapped
+                         ? "them, the constant-velocity prediction is kept along them (solution "
+                           "remapping)"
+                         : "them (degeneracy.remap off: the estimate along them is the lidar's)");
 }
 
 std::unique_ptr<LioOdometry> MakeLioOdometry(const OdometryConfig& config) {

@@ -111,6 +111,7 @@ void OdometryConfig::Validate() const {
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(window_knots >= 2, "window.knots must be >= 2");
   require(solver_threads >= 1, "window solver settings must be >= 1");
+  degeneracy.Validate();
 }
 
 namespace {
@@ -127,7 +128,7 @@ struct TopLevel {
 
 // Applies the sections of the mapping `root` onto *c: keys absent keep *c's values. `top` is
 // null inside a per-method override, where only the method-dependent sections (gp, imu, init,
-// window, lidar_frontend) are allowed; `where` prefixes key names in messages.
+// window, lidar_frontend, degeneracy) are allowed; `where` prefixes key names in messages.
 void ApplySections(const YAML::Node& root, const std::string& source, const std::string& where,
                    OdometryConfig* c, TopLevel* top) {
   for (const auto& kv : root) {
@@ -188,6 +189,13 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                       if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
                       top->extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
                     }}});
+    } else if (key == "degeneracy") {
+      ReadSection(v, section, source,
+                  {{"enabled", SetFromYaml(&c->degeneracy.enabled)},
+                   {"translation_threshold", SetFromYaml(&c->degeneracy.translation_threshold)},
+                   {"rotation_threshold", SetFromYaml(&c->degeneracy.rotation_threshold)},
+                   {"remap_information", SetFromYaml(&c->degeneracy.remap_information)},
+                   {"remap", SetFromYaml(&c->degeneracy.remap)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else {

@@ -78,6 +78,7 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
       break;
     }
   }
+  summary.lidar_blocks = blocks;
   return summary;
 }
 

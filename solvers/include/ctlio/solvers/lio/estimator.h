@@ -55,6 +55,9 @@ class Estimator {
   virtual double newest_time() const = 0;
   virtual SE3 NewestPose() const = 0;
   virtual SE3 PreviousPose() const = 0;
+  // The newest pose's state and A with δ_state = A·δ_body for its tangent (degeneracy.h).
+  virtual StateId NewestPoseKey() const = 0;
+  virtual Mat6 NewestPoseTangentFromBody() const = 0;
   // Odometry time of the previous state, and the estimate T_mr at times `t` within [previous,
   // newest] for a dense trajectory between the scan poses: GP interpolation between the two newest
   // knots (SPEC §2) for the GP pipelines; for the baseline the IMU propagated from the previous

@@ -34,6 +34,9 @@ class GpKnotEstimator final : public Estimator {
   double newest_time() const override { return knots_.back().t; }
   SE3 NewestPose() const override;
   SE3 PreviousPose() const override;
+  StateId NewestPoseKey() const override { return knots_.back().keys.pose; }
+  // T_rm: Exp(δ)·T_rm is the body motion T_mr·Exp(−δ).
+  Mat6 NewestPoseTangentFromBody() const override { return -Mat6::Identity(); }
   double previous_time() const override { return knots_[knots_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }

@@ -74,6 +74,12 @@ class LioOdometry {
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
+  // Degenerate directions of the registered lidar term (degeneracy.h): reported in the result;
+  // lidar_only keeps `predicted` (the newest pose state before registration) along them.
+  void AnalyseDegeneracy(const RegistrationSummary& registered, const SE3& predicted,
+                         ScanResult* result);
+  // lidar_only with a degenerate direction: the scan is `degenerate` (remapped or not).
+  void ReportDegenerateDirections(ScanResult* result) const;
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
 
   OdometryConfig config_;

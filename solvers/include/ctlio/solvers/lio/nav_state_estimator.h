@@ -40,6 +40,9 @@ class NavStateEstimator final : public Estimator {
   double newest_time() const override { return states_.back().t; }
   SE3 NewestPose() const override;
   SE3 PreviousPose() const override;
+  StateId NewestPoseKey() const override { return states_.back().keys.pose; }
+  // T_wb: Exp(δ)·T_wb = T_wb·Exp(Ad(T_wb⁻¹)δ), so δ = Ad(T_wb)·δ_body.
+  Mat6 NewestPoseTangentFromBody() const override { return NewestPose().Adjoint(); }
   double previous_time() const override { return states_[states_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override;

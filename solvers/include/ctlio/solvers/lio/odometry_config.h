@@ -17,6 +17,7 @@
 #include "ctlio/factors/imu/imu_data.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/manifolds/types.h"
+#include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
 
 namespace YAML {
@@ -86,6 +87,9 @@ struct OdometryConfig {
   double max_imu_gap = 0.05;  // s; a longer hole in the IMU stream is reported per scan
   // A scan is a failure if the pose jumps more than this between consecutive scans (m).
   double max_scan_translation = 5.0;
+  // Degenerate directions of the lidar term per scan (YAML section `degeneracy`, degeneracy.h):
+  // logged; lidar_only keeps the prediction along them and reports the scan degenerate.
+  DegeneracyOptions degeneracy;
 
   // --- Window and solver.
   int window_knots = 2;    // newest knots kept free (SPEC §4: 2, the one before held)
@@ -106,8 +110,8 @@ struct OdometryConfig {
 };
 
 // Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
-// `lidar_frontend` and `per_method`. Missing keys keep their defaults; unknown keys and bad
-// values throw std::runtime_error naming file and line. `per_method` maps a method name
+// `lidar_frontend`, `degeneracy` and `per_method`. Missing keys keep their defaults; unknown keys
+// and bad values throw std::runtime_error naming file and line. `per_method` maps a method name
 // (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`, `window`,
 // `lidar_frontend` whose keys replace the base values for that method only (same keys, same
 // checks; `method` and `extrinsic` cannot be set per method):
@@ -151,6 +155,9 @@ struct ScanResult {
   double ms_solve = 0.0;        // Ceres, all rounds
   double ms_map = 0.0;          // deskew + map insertion
   double ms_marginalize = 0.0;  // Schur complement of the leaving knot
+  // Degenerate directions of this scan's lidar term (degeneracy.h); analysed = false when the
+  // scan was not registered or the analysis is off.
+  DegeneracyReport degeneracy;
   // CPU time of this scan's thread (CLOCK_THREAD_CPUTIME_ID): unlike the wall times above it
   // does not grow when other processes share the cores.
   double cpu_ms = 0.0;

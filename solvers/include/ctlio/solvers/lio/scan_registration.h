@@ -17,6 +17,7 @@
 #include <ceres/loss_function.h>
 
 #include <memory>
+#include <vector>
 
 #include "ctlio/factors/lidar/point_to_plane.h"
 #include "ctlio/manifolds/se3.h"
@@ -53,6 +54,7 @@ struct RegistrationSummary {
   bool degenerate = false;    // too few associations: the lidar term was dropped
   double ms_associate = 0.0;  // wall time of the association, all rounds
   double ms_solve = 0.0;      // wall time of the solves, all rounds
+  std::vector<ceres::ResidualBlockId> lidar_blocks;  // the last round's residuals (in the window)
 };
 
 // The robust loss of the point-to-plane residuals (cauchy/huber/none, SPEC §4): the residuals

@@ -1,0 +1,146 @@
+#include "ctlio/solvers/lio/degeneracy.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "ctlio/solvers/schur_complement.h"
+
+namespace ctlio::lio {
+
+void DegeneracyOptions::Validate() const {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("OdometryConfig: ") + what);
+  };
+  require(translation_threshold >= 0 && translation_threshold < 3,
+          "degeneracy.translation_threshold must be in [0, 3)");
+  require(rotation_threshold >= 0 && rotation_threshold < 3,
+          "degeneracy.rotation_threshold must be in [0, 3)");
+  require(remap_information > 0, "degeneracy.remap_information must be positive");
+}
+
+std::string DegeneracyReport::DirectionString() const {
+  if (directions.empty()) return "-";
+  const Vec6& u = directions.front();
+  const bool translation = u.head<3>().squaredNorm() >= u.tail<3>().squaredNorm();
+  const Vec3 v = translation ? Vec3(u.head<3>()) : Vec3(u.tail<3>());
+  std::ostringstream s;
+  s.precision(3);
+  s << std::fixed << (translation ? "t:" : "r:") << v.x() << ',' << v.y() << ',' << v.z();
+  return s.str();
+}
+
+namespace {
+
+// The ordering of Linearize: `pose` first, then every other non-constant state the residuals
+// touch, in ascending id (deterministic).
+std::vector<StateId> Ordering(const SlidingWindow& window,
+                              const std::vector<ceres::ResidualBlockId>& residuals, StateId pose) {
+  std::vector<StateId> ids;
+  for (const ceres::ResidualBlockId r : residuals) {
+    for (const StateId id : window.StatesOf(r)) {
+      if (id != pose && !window.IsStateConstant(id)) ids.push_back(id);
+    }
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  ids.insert(ids.begin(), pose);
+  return ids;
+}
+
+Mat6 ToBody(const Eigen::MatrixXd& H_state, const Mat6& A) {
+  const Mat6 H = A.transpose() * H_state * A;
+  return 0.5 * (H + H.transpose());
+}
+
+// Block b (0 translation, 1 rotation) with the other block marginalised (Schur complement).
+Mat3 MarginalBlock(const Mat6& H, int b) {
+  const SchurComplementResult s = b == 0 ? SchurComplement(H, Vec6::Zero(), {0, 1, 2}, {3, 4, 5})
+                                         : SchurComplement(H, Vec6::Zero(), {3, 4, 5}, {0, 1, 2});
+  return s.information;
+}
+
+}  // namespace
+
+Mat6 PoseInformation(const SlidingWindow& window,
+                     const std::vector<ceres::ResidualBlockId>& residuals, StateId pose,
+                     const Mat6& A) {
+  if (window.IsStateConstant(pose)) return Mat6::Zero();
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  window.Linearize(residuals, Ordering(window, residuals, pose), &H, &b);
+  return ToBody(H.topLeftCorner<6, 6>(), A);
+}
+
+Mat6 OtherInformation(const SlidingWindow& window,
+                      const std::vector<ceres::ResidualBlockId>& excluded, StateId pose,
+                      const Mat6& A) {
+  if (window.IsStateConstant(pose)) return Mat6::Zero();
+  const std::unordered_set<ceres::ResidualBlockId> skip(excluded.begin(), excluded.end());
+  std::unordered_set<ceres::ResidualBlockId> seen;
+  std::vector<ceres::ResidualBlockId> others;
+  for (const StateId id : window.StateIds()) {
+    for (const ceres::ResidualBlockId r : window.ResidualBlocksOf(id)) {
+      if (skip.count(r) == 0 && seen.insert(r).second) others.push_back(r);
+    }
+  }
+  if (others.empty()) return Mat6::Zero();
+  const std::vector<StateId> ordering = Ordering(window, others, pose);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  window.Linearize(others, ordering, &H, &b);
+  std::vector<int> keep(6), marginalize;
+  for (int i = 0; i < 6; ++i) keep[i] = i;
+  for (int i = 6; i < H.rows(); ++i) marginalize.push_back(i);
+  const SchurComplementResult s = SchurComplement(H, b, keep, marginalize);
+  return ToBody(s.information, A);
+}
+
+DegeneracyReport AnalyseDegeneracy(const Mat6& H, const DegeneracyOptions& options) {
+  DegeneracyReport report;
+  report.analysed = true;
+  struct Candidate {
+    double nu;
+    Vec6 u;
+  };
+  std::vector<Candidate> degenerate;
+  for (int b = 0; b < 2; ++b) {
+    const Mat3 S = MarginalBlock(H, b);
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(S);  // ascending eigenvalues
+    const double mean = S.trace() / 3.0;
+    const Vec3 nu = mean > 0 ? Vec3(eig.eigenvalues().cwiseMax(0.0) / mean) : Vec3::Zero();
+    (b == 0 ? report.translation_eigenvalues : report.rotation_eigenvalues) = nu;
+    const double threshold = b == 0 ? options.translation_threshold : options.rotation_threshold;
+    for (int i = 0; i < 3; ++i) {
+      if (nu[i] >= threshold) continue;
+      Vec6 u = Vec6::Zero();
+      u.segment<3>(3 * b) = eig.eigenvectors().col(i).normalized();
+      // Sign convention: largest component positive (the direction, not its sign, matters).
+      Eigen::Index k;
+      u.cwiseAbs().maxCoeff(&k);
+      if (u[k] < 0) u = -u;
+      degenerate.push_back({nu[i], u});
+    }
+  }
+  std::stable_sort(degenerate.begin(), degenerate.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.nu < b.nu; });
+  for (const Candidate& c : degenerate) report.directions.push_back(c.u);
+  if (!report.directions.empty()) {
+    const Vec6& u = report.directions.front();
+    report.lidar_information = u.dot(H * u);
+  }
+  return report;
+}
+
+Mat6 RemapSqrtInformation(const DegeneracyReport& report, const DegeneracyOptions& options,
+                          const Mat6& A) {
+  Mat6 P = Mat6::Zero();
+  for (const Vec6& u : report.directions) P += u * u.transpose();
+  // r = √w·P·δ_body with δ_body = A⁻¹·δ_state.
+  return std::sqrt(options.remap_information) * P * A.inverse();
+}
+
+}  // namespace ctlio::lio
