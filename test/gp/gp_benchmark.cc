@@ -90,6 +90,34 @@ void BM_InterpolatePose_Jacobians(benchmark::State& state) {
 }
 BENCHMARK(BM_InterpolatePose_Jacobians)->Arg(0)->Arg(1);
 
+// The per-interval part alone (γ_{k+1} and its Jacobians, knot_state.h), which a window forms once
+// per evaluation for all the interpolations between the same knots (gp/shared_knot_interval.h) …
+void BM_LocalVariables_Jacobians(benchmark::State& state) {
+  const Fixture f;
+  for (auto _ : state) {
+    const LocalVariables lv(f.k, f.k1, true);
+    benchmark::DoNotOptimize(lv.D2);
+  }
+}
+BENCHMARK(BM_LocalVariables_Jacobians);
+
+// … and the per-τ part that remains for each interpolation given them (the marginal cost of one
+// more lidar firing on an interval in the solve).
+void BM_InterpolatePose_JacobiansSharedInterval(benchmark::State& state) {
+  const Fixture f;
+  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const LocalVariables lv(f.k, f.k1, true);
+  SE3 T;
+  PoseJacobian J0, J1;
+  for (auto _ : state) {
+    interp.Pose(f.k, lv, &T, &J0, &J1);
+    benchmark::DoNotOptimize(T);
+    benchmark::DoNotOptimize(J0);
+    benchmark::DoNotOptimize(J1);
+  }
+}
+BENCHMARK(BM_InterpolatePose_JacobiansSharedInterval)->Arg(0)->Arg(1);
+
 void BM_InterpolatePose_Value(benchmark::State& state) {
   const Fixture f;
   const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);

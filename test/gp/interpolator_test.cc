@@ -6,6 +6,7 @@
 #include <ceres/sized_cost_function.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -384,6 +385,74 @@ TEST(GpInterpolatorRowsTest, SelectedRowsEqualFullStateAndLeaveOthersUntouched) 
             }
           }
         }
+      }
+    }
+  }
+}
+
+// The overloads that take the interval's local variables (formed once per evaluation for all
+// interpolations between the same knots, shared_knot_interval.h) are the same computation:
+// bit-identical poses, states and Jacobians, so sharing them cannot move a solution.
+TEST(GpInterpolatorTest, SharedLocalVariablesGiveBitIdenticalResults) {
+  std::mt19937 rng(29);
+  for (const Case& c : Cases()) {
+    Vec6 qc;
+    qc << 1, 2, 3, 4, 5, 6;
+    const SingerModel<6> model(qc, c.alpha);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Knots K = MakeKnots(rng, c);
+      const LocalVariables local(K.k, K.k1, true);
+      for (const double frac : {0.0, c.frac, 1.0}) {
+        const GpInterpolator interp(model, 3.0, 3.0 + c.dt, 3.0 + frac * c.dt);
+        SE3 T_a, T_b;
+        PoseJacobian P0a, P1a, P0b, P1b;
+        interp.Pose(K.k, K.k1, &T_a, &P0a, &P1a);
+        interp.Pose(K.k, local, &T_b, &P0b, &P1b);
+        EXPECT_TRUE(T_a.Matrix() == T_b.Matrix()) << c.name;
+        EXPECT_TRUE(P0a == P0b && P1a == P1b) << c.name << " pose Jacobians";
+        for (const unsigned mask : RowMasks()) {
+          KnotState x_a, x_b;
+          StateJacobian R0a = StateJacobian::Zero(), R1a = R0a, R0b = R0a, R1b = R0a;
+          interp.StateRows(K.k, K.k1, mask, &x_a, &R0a, &R1a);
+          interp.StateRows(K.k, local, mask, &x_b, &R0b, &R1b);
+          EXPECT_TRUE(x_a.pose.Matrix() == x_b.pose.Matrix() && x_a.velocity == x_b.velocity &&
+                      x_a.acceleration == x_b.acceleration)
+              << c.name << " mask " << mask;
+          EXPECT_TRUE(R0a == R0b && R1a == R1b) << c.name << " mask " << mask;
+        }
+      }
+    }
+  }
+}
+
+// The row-first chain (PoseAt + ChainPose, what a point-to-plane residual uses) against the
+// Jacobians of Pose(): the same T(τ) bit for bit, and u·∂δT(τ)/∂knots equal up to rounding,
+// at every case (|φ| near π, near-identity, α·Δt at the series switch and → 0).
+TEST(GpInterpolatorTest, ChainPoseEqualsRowOfPoseJacobians) {
+  std::mt19937 rng(41);
+  for (const Case& c : Cases()) {
+    Vec6 qc;
+    qc << 1, 2, 3, 4, 5, 6;
+    const SingerModel<6> model(qc, c.alpha);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Knots K = MakeKnots(rng, c);
+      LocalVariables local(K.k, K.k1, true);
+      local.AddChainProducts();
+      for (const double frac : {0.0, c.frac, 1.0}) {
+        const GpInterpolator interp(model, 3.0, 3.0 + c.dt, 3.0 + frac * c.dt);
+        SE3 T;
+        PoseJacobian P0, P1;
+        interp.Pose(K.k, K.k1, &T, &P0, &P1);
+        GpInterpolator::PoseAtTau at;
+        interp.PoseAt(K.k, local, &at);
+        EXPECT_TRUE(at.T.Matrix() == T.Matrix()) << c.name;
+        const Eigen::Matrix<double, 1, 6> u = RandomVec6(rng, 1.0).transpose();
+        Eigen::Matrix<double, 1, 18> C0, C1;
+        interp.ChainPose(at, local, u, &C0, &C1);
+        const Eigen::Matrix<double, 1, 18> R0 = u * P0, R1 = u * P1;
+        const double scale = std::max({1.0, R0.cwiseAbs().maxCoeff(), R1.cwiseAbs().maxCoeff()});
+        EXPECT_LE((C0 - R0).cwiseAbs().maxCoeff(), 1e-13 * scale) << c.name << " knot k";
+        EXPECT_LE((C1 - R1).cwiseAbs().maxCoeff(), 1e-13 * scale) << c.name << " knot k+1";
       }
     }
   }

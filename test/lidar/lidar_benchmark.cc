@@ -7,9 +7,11 @@
 #include <filesystem>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include "common/gradient_check.h"
 #include "ctlio/factors/gp/interpolator.h"
+#include "ctlio/factors/gp/shared_knot_interval.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
 #include "ctlio/factors/lidar/point_to_plane.h"
 #include "ctlio/io/point_cloud_io.h"
@@ -126,6 +128,59 @@ void BM_ContinuousPointToPlane(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ContinuousPointToPlane)->Arg(0)->Arg(1);
+
+// One lidar residual as a window's solve evaluates it: per iteration the knots move (a new
+// evaluation point), the evaluation callback prepares each firing's interpolation once with the
+// interval's local variables formed once (gp/shared_knot_interval.h), and each firing's residual
+// is evaluated with Jacobians. The main job has ~600 keypoints on ~1800 firings, i.e. about one
+// residual per firing: Arg = firings on the interval, one residual each. Counter per_point: CPU
+// time per residual including its firing's interpolation, to set beside
+// BM_ContinuousPointToPlane/1, which interpolates on its own.
+void BM_ContinuousPointToPlaneInSolve(benchmark::State& state) {
+  std::mt19937 rng(4);
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  const gp::SingerModel<6> model(qc, alpha);
+  const SE3 T_k = testing::RandomPose(rng, 1.0, 5.0);
+  const auto pk = testing::PoseParameters(T_k);
+  const auto pk1 = testing::PoseParameters(testing::RandomPose(rng, 0.2, 0.3) * T_k);
+  const Vec6 w_k = testing::RandomVec6(rng, 1.0), a_k = testing::RandomVec6(rng, 5.0);
+  Vec6 w_k1 = testing::RandomVec6(rng, 1.0);
+  const Vec6 a_k1 = testing::RandomVec6(rng, 5.0);
+  const gp::KnotBlocks knots = {pk.data(),  w_k.data(),  a_k.data(),
+                                pk1.data(), w_k1.data(), a_k1.data()};
+  const auto interval = std::make_shared<gp::SharedKnotInterval>(knots);
+  const int n = static_cast<int>(state.range(0));
+  std::vector<std::shared_ptr<SharedPoseInterpolation>> firings;
+  std::vector<std::unique_ptr<ContinuousPointToPlane>> costs;
+  for (int i = 0; i < n; ++i) {
+    firings.push_back(std::make_shared<SharedPoseInterpolation>(
+        std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.1 * (i + 0.5) / n), knots));
+    firings.back()->set_interval(interval);
+    costs.push_back(std::make_unique<ContinuousPointToPlane>(firings.back(), SomeAssociation()));
+  }
+  double r, J0[7], J1[6], J2[6], J3[7], J4[6], J5[6], step = 1e-9;
+  double* jac[] = {J0, J1, J2, J3, J4, J5};
+  for (auto _ : state) {
+    w_k1[0] += step;  // a new evaluation point: everything is prepared again
+    step = -step;
+    for (const auto& f : firings) f->Prepare();
+    for (const auto& c : costs) {
+      c->Evaluate(knots.data(), &r, jac);
+      benchmark::DoNotOptimize(r);
+      benchmark::DoNotOptimize(J0[0]);
+    }
+    benchmark::ClobberMemory();
+  }
+  int64_t computed = 0;
+  for (const auto& f : firings) computed += f->num_computed();
+  if (computed != 0) state.SkipWithError("a residual interpolated on its own");
+  state.counters["per_point"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * n,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_ContinuousPointToPlaneInSolve)->Arg(1)->Arg(20);
 
 // The real-data test's pipeline on sweep 00 (25,109 points): preprocessing, keypoints, rigid
 // fit, then the two-knot continuous-time registration.

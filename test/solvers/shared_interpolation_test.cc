@@ -1,5 +1,7 @@
 // The window's evaluation callback (SharedInterpolationCallback, a ceres::EvaluationCallback):
-// continuous-time point-to-plane residuals whose firings share one SharedPoseInterpolation must
+// continuous-time point-to-plane residuals whose firings share one SharedPoseInterpolation, and
+// the gyro and accelerometer residuals of an IMU sample sharing one gp::SharedStateInterpolation
+// (all of them on one knot interval, whose local variables the callback forms once), must
 // (a) read the prepared interpolation in every evaluation of Ceres' solve and of the window's
 // own linearisation (marginalisation, covariance) — none interpolates on its own — and
 // (b) give the same solution and the same marginal prior as the same residuals without sharing.
@@ -12,7 +14,9 @@
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/gp/singer_prior.h"
+#include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
 #include "ctlio/factors/priors/state_prior.h"
 #include "ctlio/manifolds/pose_manifold.h"
@@ -22,7 +26,7 @@ namespace ctlio {
 namespace {
 
 constexpr double kT1 = 0.1;  // knot times 0 and kT1
-constexpr int kFirings = 12, kPointsPerFiring = 8;
+constexpr int kFirings = 12, kPointsPerFiring = 8, kImuSamples = 10;
 
 gp::SingerModel<6> Model() {
   Vec6 qc, alpha;
@@ -78,7 +82,8 @@ Scene MakeScene(uint32_t seed) {
 
 struct Built {
   std::unique_ptr<SlidingWindow> window;
-  std::vector<std::shared_ptr<SharedPoseInterpolation>> firings;  // empty without sharing
+  std::vector<std::shared_ptr<SharedPoseInterpolation>> firings;   // empty without sharing
+  std::vector<std::shared_ptr<gp::SharedStateInterpolation>> imu;  // empty without sharing
 };
 
 Built Build(const Scene& s, bool shared) {
@@ -115,19 +120,58 @@ Built Build(const Scene& s, bool shared) {
       w.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), ids);
     }
   }
+  // IMU samples (gyro + accelerometer with the exact specific force and a Cauchy loss, as in the
+  // LIO) read from the true trajectory; biases and gravity held.
+  const Vec6 zero = Vec6::Zero();
+  w.AddVectorState(6, zero);
+  w.AddVectorState(7, zero);
+  w.AddRotationState(8, Mat3::Identity());
+  for (StateId id : {6, 7, 8}) w.SetStateConstant(id, true);
+  std::vector<StateId> imu_ids = ids;
+  imu_ids.push_back(6);
+  imu_ids.push_back(7);
+  for (int i = 0; i < kImuSamples; ++i) {
+    const double tau = kT1 * (i + 0.3) / kImuSamples;
+    gp::KnotState x;
+    gp::GpInterpolator(Model(), 0.0, kT1, tau).State(s.truth0, s.truth1, &x, nullptr, nullptr);
+    const Vec3 gyro = -x.velocity.tail<3>();
+    const Vec3 accel = -x.acceleration.head<3>() +
+                       x.velocity.tail<3>().cross(x.velocity.head<3>()) -
+                       x.pose.rotation() * Vec3(0, 0, -9.81);
+    const Mat3 cov = 1e-4 * Mat3::Identity();
+    const auto exact = imu::AccelModel::kSpecificForce;
+    ceres::CostFunction *g = nullptr, *a = nullptr;
+    if (shared) {
+      const auto state =
+          std::make_shared<gp::SharedStateInterpolation>(Model(), 0.0, kT1, tau, blocks);
+      w.shared_interpolations().Add(state);
+      b.imu.push_back(state);
+      g = new imu::ImuGyroMeasurement(state, gyro, cov);
+      a = new imu::ImuAccelMeasurement(state, accel, cov, 9.81, exact);
+    } else {
+      g = new imu::ImuGyroMeasurement(Model(), 0.0, kT1, tau, gyro, cov);
+      a = new imu::ImuAccelMeasurement(Model(), 0.0, kT1, tau, accel, cov, 9.81, exact);
+    }
+    w.AddResidualBlock(g, nullptr, imu_ids);
+    std::vector<StateId> accel_ids = imu_ids;
+    accel_ids.push_back(8);
+    w.AddResidualBlock(a, new ceres::CauchyLoss(1.0), accel_ids);
+  }
   return b;
 }
 
 int64_t Computed(const Built& b) {
   int64_t n = 0;
   for (const auto& f : b.firings) n += f->num_computed();
+  for (const auto& f : b.imu) n += f->num_computed();
   return n;
 }
 
 TEST(SharedInterpolationCallback, SolveReadsPreparedInterpolationAndMatchesUnshared) {
   const Scene scene = MakeScene(3);
   Built shared = Build(scene, true), plain = Build(scene, false);
-  EXPECT_EQ(shared.window->shared_interpolations().size(), static_cast<size_t>(kFirings));
+  EXPECT_EQ(shared.window->shared_interpolations().size(),
+            static_cast<size_t>(kFirings + kImuSamples));
   const ceres::Solver::Summary a = shared.window->Solve();
   const ceres::Solver::Summary b = plain.window->Solve();
   EXPECT_GT(a.iterations.size(), 2u);
@@ -168,6 +212,7 @@ TEST(SharedInterpolationCallback, MarginalizationPreparesBeforeLinearising) {
   EXPECT_GT(report.prior_rank, 0);
   EXPECT_EQ(Computed(shared), 0);
   shared.firings.clear();
+  shared.imu.clear();
   EXPECT_EQ(shared.window->shared_interpolations().size(), 0u);
 }
 

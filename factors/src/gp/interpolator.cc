@@ -46,21 +46,24 @@ void ApplyDiag(const OutputMap& M, const Diag& d0, const Diag& d1, const Diag& d
 
 // The one implementation behind GpInterpolator (omega, k1 non-null) and GpExtrapolator
 // (both null, lambda = Φ(τ−t_k)). R = 6: pose only; R = 18: full state.
+// `shared`: the interval's LocalVariables (with Jacobians) when the caller has them already.
 template <int R>
 void Evaluate(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>* omega, const KnotState& k,
-              const KnotState* k1, SE3* T, Vec6* velocity, Vec6* acceleration,
-              Eigen::Matrix<double, R, 18>* J_k, Eigen::Matrix<double, R, 18>* J_k1) {
+              const KnotState* k1, const LocalVariables* shared, SE3* T, Vec6* velocity,
+              Vec6* acceleration, Eigen::Matrix<double, R, 18>* J_k,
+              Eigen::Matrix<double, R, 18>* J_k1) {
   const bool jac = J_k != nullptr || J_k1 != nullptr;
-  const bool two_knots = k1 != nullptr;
+  const bool two_knots = k1 != nullptr || shared != nullptr;
   // γ(τ) = Λγ_k + Ωγ_{k+1}, γ_k = [0; ϖ_k; ϖ̇_k].
   Vec6 g[3];
   for (int r = 0; r < 3; ++r) {
     g[r] = (lambda.block(r, 1) * k.velocity.array() + lambda.block(r, 2) * k.acceleration.array())
                .matrix();
   }
-  std::optional<LocalVariables> lv;
+  std::optional<LocalVariables> own;
+  const LocalVariables* lv = shared;
   if (two_knots) {
-    lv.emplace(k, *k1, jac);
+    if (lv == nullptr) lv = &own.emplace(k, *k1, jac);
     for (int r = 0; r < 3; ++r) {
       g[r].array() += omega->block(r, 0) * lv->gamma[0].array() +
                       omega->block(r, 1) * lv->gamma[1].array() +
@@ -162,10 +165,11 @@ Eigen::Matrix<double, N, 6> RowsTimesDiag(const OutputMap& M, int L, int h, cons
 //   ∂/∂ϖ̇_{k+1} = B_2·J⁻¹,  ∂/∂δT_k = −∂/∂δT_{k+1}·Ad21 (+ Ad(Exp ξ) on the pose rows),
 //   ∂/∂ϖ_k = Σ_r M_{Lr}·diag(Λ_r1),  ∂/∂ϖ̇_k = Σ_r M_{Lr}·diag(Λ_r2).
 void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& omega,
-                  const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
-                  StateJacobian* J_k, StateJacobian* J_k1) {
+                  const KnotState& k, const KnotState* k1, const LocalVariables* shared,
+                  unsigned rows, KnotState* x, StateJacobian* J_k, StateJacobian* J_k1) {
   const bool jac = (J_k != nullptr || J_k1 != nullptr) && (rows & kAllStateRows) != 0;
-  const LocalVariables lv(k, k1, jac);
+  std::optional<LocalVariables> own;
+  const LocalVariables& lv = shared != nullptr ? *shared : own.emplace(k, *k1, jac);
   Vec6 g[3];
   for (int r = 0; r < 3; ++r) {
     g[r] = (lambda.block(r, 1) * k.velocity.array() + lambda.block(r, 2) * k.acceleration.array() +
@@ -293,19 +297,74 @@ GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t
 
 void GpInterpolator::Pose(const KnotState& k, const KnotState& k1, SE3* T, PoseJacobian* J_k,
                           PoseJacobian* J_k1) const {
-  Evaluate<6>(lambda_, &omega_, k, &k1, T, nullptr, nullptr, J_k, J_k1);
+  Evaluate<6>(lambda_, &omega_, k, &k1, nullptr, T, nullptr, nullptr, J_k, J_k1);
+}
+
+void GpInterpolator::Pose(const KnotState& k, const LocalVariables& local, SE3* T,
+                          PoseJacobian* J_k, PoseJacobian* J_k1) const {
+  Evaluate<6>(lambda_, &omega_, k, nullptr, &local, T, nullptr, nullptr, J_k, J_k1);
 }
 
 void GpInterpolator::State(const KnotState& k, const KnotState& k1, KnotState* x,
                            StateJacobian* J_k, StateJacobian* J_k1) const {
   KnotState tmp;
   KnotState* out = x != nullptr ? x : &tmp;
-  Evaluate<18>(lambda_, &omega_, k, &k1, &out->pose, &out->velocity, &out->acceleration, J_k, J_k1);
+  Evaluate<18>(lambda_, &omega_, k, &k1, nullptr, &out->pose, &out->velocity, &out->acceleration,
+               J_k, J_k1);
 }
 
 void GpInterpolator::StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
                                StateJacobian* J_k, StateJacobian* J_k1) const {
-  EvaluateRows(lambda_, omega_, k, k1, rows, x, J_k, J_k1);
+  EvaluateRows(lambda_, omega_, k, &k1, nullptr, rows, x, J_k, J_k1);
+}
+
+void GpInterpolator::StateRows(const KnotState& k, const LocalVariables& local, unsigned rows,
+                               KnotState* x, StateJacobian* J_k, StateJacobian* J_k1) const {
+  EvaluateRows(lambda_, omega_, k, nullptr, &local, rows, x, J_k, J_k1);
+}
+
+void GpInterpolator::PoseAt(const KnotState& k, const LocalVariables& local, PoseAtTau* out) const {
+  // ξ = row 0 of γ(τ) = Λγ_k + Ωγ_{k+1}, summed as in Evaluate (so T(τ) is bit-identical).
+  Vec6 xi =
+      (lambda_.block(0, 1) * k.velocity.array() + lambda_.block(0, 2) * k.acceleration.array())
+          .matrix();
+  xi.array() += omega_.block(0, 0) * local.gamma[0].array() +
+                omega_.block(0, 1) * local.gamma[1].array() +
+                omega_.block(0, 2) * local.gamma[2].array();
+  const SE3 E = SE3::Exp(xi);
+  out->T = E * k.pose;
+  out->J = se3::LeftJacobian(xi);
+  out->Ad = E.Adjoint();
+}
+
+void GpInterpolator::ChainPose(const PoseAtTau& at, const LocalVariables& local,
+                               const Eigen::Matrix<double, 1, 6>& u,
+                               Eigen::Matrix<double, 1, 18>* J_k,
+                               Eigen::Matrix<double, 1, 18>* J_k1) const {
+  using Row6 = Eigen::Matrix<double, 1, 6>;
+  const Row6 v = u * at.J;
+  const auto scaled = [&v](const Diag& d) -> Row6 {
+    return v.cwiseProduct(d.matrix().transpose());
+  };
+  const Row6 a0 = scaled(omega_.block(0, 0)), a1 = scaled(omega_.block(0, 1)),
+             a2 = scaled(omega_.block(0, 2));
+  Row6 t1 = a0 * local.J_inv;
+  t1.noalias() += a1 * local.DJ1;
+  t1.noalias() += a2 * local.DJ2;
+  if (J_k1 != nullptr) {
+    J_k1->leftCols<6>() = t1;
+    auto w = J_k1->middleCols<6>(6);
+    w.noalias() = a1 * local.J_inv;
+    w.noalias() += a2 * local.E;
+    J_k1->rightCols<6>().noalias() = a2 * local.J_inv;
+  }
+  if (J_k != nullptr) {
+    auto p = J_k->leftCols<6>();
+    p.noalias() = u * at.Ad;
+    p.noalias() -= t1 * local.Ad21;
+    J_k->middleCols<6>(6) = scaled(lambda_.block(0, 1));
+    J_k->rightCols<6>() = scaled(lambda_.block(0, 2));
+  }
 }
 
 GpExtrapolator::GpExtrapolator(const SingerModel<6>& model, double t_k, double tau) {
@@ -321,14 +380,14 @@ GpExtrapolator::GpExtrapolator(const SingerModel<6>& model, double t_k, double t
 }
 
 void GpExtrapolator::Pose(const KnotState& k, SE3* T, PoseJacobian* J_k) const {
-  Evaluate<6>(phi_, nullptr, k, nullptr, T, nullptr, nullptr, J_k, nullptr);
+  Evaluate<6>(phi_, nullptr, k, nullptr, nullptr, T, nullptr, nullptr, J_k, nullptr);
 }
 
 void GpExtrapolator::State(const KnotState& k, KnotState* x, StateJacobian* J_k) const {
   KnotState tmp;
   KnotState* out = x != nullptr ? x : &tmp;
-  Evaluate<18>(phi_, nullptr, k, nullptr, &out->pose, &out->velocity, &out->acceleration, J_k,
-               nullptr);
+  Evaluate<18>(phi_, nullptr, k, nullptr, nullptr, &out->pose, &out->velocity, &out->acceleration,
+               J_k, nullptr);
 }
 
 }  // namespace ctlio::gp

@@ -13,7 +13,18 @@ namespace {
 using Row3x18 = Eigen::Matrix<double, 3, 18>;
 using Jac3x6 = Eigen::Matrix<double, 3, 6, Eigen::RowMajor>;
 
-double Fraction(double t_k, double t_k1, double tau) { return (tau - t_k) / (t_k1 - t_k); }
+// A state interpolation of a factor's own (not shared), asking for `rows`.
+std::shared_ptr<gp::SharedStateInterpolation> OwnState(const gp::SingerModel<6>& model, double t_k,
+                                                       double t_k1, double tau) {
+  return std::make_shared<gp::SharedStateInterpolation>(model, t_k, t_k1, tau);
+}
+
+// Registers `rows` with a (possibly shared) state and returns it.
+std::shared_ptr<gp::SharedStateInterpolation> WithRows(
+    std::shared_ptr<gp::SharedStateInterpolation> state, unsigned rows) {
+  state->AddRows(rows);
+  return state;
+}
 
 // Writes D·J (3×18) of one knot into its pose (lifted), ϖ and ϖ̇ blocks.
 void WriteKnotJacobians(const Row3x18& DJ, const double* pose, double* j_pose, double* j_vel,
@@ -32,8 +43,13 @@ Mat3 SqrtInformation(const Mat3& covariance) {
 ImuGyroMeasurement::ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
                                        double tau, const Vec3& gyro, const Mat3& covariance,
                                        const ImuMounting& mounting)
-    : interpolator_(model, t_k, t_k1, tau),
-      s_(Fraction(t_k, t_k1, tau)),
+    : ImuGyroMeasurement(OwnState(model, t_k, t_k1, tau), gyro, covariance, mounting) {}
+
+ImuGyroMeasurement::ImuGyroMeasurement(std::shared_ptr<gp::SharedStateInterpolation> state,
+                                       const Vec3& gyro, const Mat3& covariance,
+                                       const ImuMounting& mounting)
+    : state_(WithRows(std::move(state), Rows())),
+      s_(state_->fraction()),
       gyro_(gyro),
       sqrt_information_(SqrtInformation(covariance)),
       C_ir_(mounting.C_ri.transpose()),
@@ -42,17 +58,17 @@ ImuGyroMeasurement::ImuGyroMeasurement(const gp::SingerModel<6>& model, double t
 
 bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
-  const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
-  const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const bool need_knots =
       jacobians != nullptr &&
       (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr ||
        jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
-  gp::KnotState x;
-  gp::StateJacobian J_k, J_k1;  // only the ϖ_ω rows are written and read
-  interpolator_.StateRows(k, k1, gp::kAngularVelocityRows, &x, need_knots ? &J_k : nullptr,
-                          need_knots ? &J_k1 : nullptr);
+  gp::SharedStateInterpolation::Result scratch;  // only the ϖ_ω rows are read
+  const gp::SharedStateInterpolation::Result& interpolated =
+      state_->State(parameters, Rows(), need_knots, &scratch);
+  const gp::KnotState& x = interpolated.x;
+  const gp::StateJacobian& J_k = interpolated.J_k;
+  const gp::StateJacobian& J_k1 = interpolated.J_k1;
 
   const Vec3 bg = (1.0 - s_) * b_k.tail<3>() + s_ * b_k1.tail<3>();
   const Vec3 w_imu = rotated_ ? Vec3(C_ir_ * x.velocity.tail<3>()) : Vec3(x.velocity.tail<3>());
@@ -75,12 +91,25 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
   return true;
 }
 
+unsigned ImuAccelMeasurement::Rows(AccelModel accel_model, const ImuMounting& mounting) {
+  const bool exact = accel_model == AccelModel::kSpecificForce;
+  return gp::kRotationRows | gp::kLinearAccelerationRows |
+         (exact ? gp::kLinearVelocityRows | gp::kAngularVelocityRows : 0u) |
+         (mounting.HasLeverArm() ? gp::kAngularVelocityRows | gp::kAngularAccelerationRows : 0u);
+}
+
 ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1,
                                          double tau, const Vec3& accel, const Mat3& covariance,
                                          double gravity, AccelModel accel_model,
                                          const ImuMounting& mounting)
-    : interpolator_(model, t_k, t_k1, tau),
-      s_(Fraction(t_k, t_k1, tau)),
+    : ImuAccelMeasurement(OwnState(model, t_k, t_k1, tau), accel, covariance, gravity, accel_model,
+                          mounting) {}
+
+ImuAccelMeasurement::ImuAccelMeasurement(std::shared_ptr<gp::SharedStateInterpolation> state,
+                                         const Vec3& accel, const Mat3& covariance, double gravity,
+                                         AccelModel accel_model, const ImuMounting& mounting)
+    : state_(WithRows(std::move(state), Rows(accel_model, mounting))),
+      s_(state_->fraction()),
       accel_(accel),
       sqrt_information_(SqrtInformation(covariance)),
       gravity_i_(0.0, 0.0, -gravity),
@@ -89,12 +118,11 @@ ImuAccelMeasurement::ImuAccelMeasurement(const gp::SingerModel<6>& model, double
       S_C_ir_(sqrt_information_ * C_ir_),
       rotated_(mounting.HasRotation()),
       lever_arm_(mounting.lever_arm),
-      lever_arm_nonzero_(mounting.HasLeverArm()) {}
+      lever_arm_nonzero_(mounting.HasLeverArm()),
+      rows_(Rows(accel_model, mounting)) {}
 
 bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
-  const gp::KnotState k1 = gp::ReadKnotState(parameters[3], parameters[4], parameters[5]);
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const Mat3 C_mi = RotationManifold::Rotation(parameters[8]);
   bool need_knots = false;
@@ -103,15 +131,13 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
   }
   const bool exact = accel_model_ == AccelModel::kSpecificForce;
   const bool lever = lever_arm_nonzero_;
-  // Only the rows D reads (below) are written: δφ and ϖ̇_v, ϖ for the exact model, ϖ_ω and ϖ̇_ω
-  // for a lever arm.
-  const unsigned rows = gp::kRotationRows | gp::kLinearAccelerationRows |
-                        (exact ? gp::kLinearVelocityRows | gp::kAngularVelocityRows : 0u) |
-                        (lever ? gp::kAngularVelocityRows | gp::kAngularAccelerationRows : 0u);
-  gp::KnotState x;
-  gp::StateJacobian J_k, J_k1;
-  interpolator_.StateRows(k, k1, rows, &x, need_knots ? &J_k : nullptr,
-                          need_knots ? &J_k1 : nullptr);
+  // Only the rows D reads (below, rows_) are read.
+  gp::SharedStateInterpolation::Result scratch;
+  const gp::SharedStateInterpolation::Result& interpolated =
+      state_->State(parameters, rows_, need_knots, &scratch);
+  const gp::KnotState& x = interpolated.x;
+  const gp::StateJacobian& J_k = interpolated.J_k;
+  const gp::StateJacobian& J_k1 = interpolated.J_k1;
 
   const Mat3& C = x.pose.rotation();  // C_rm(τ)
   const Vec3 g_m = C_mi * gravity_i_;

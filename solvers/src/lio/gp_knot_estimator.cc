@@ -5,6 +5,7 @@
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/knot_state.h"
+#include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/gp/singer_prior.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/manifolds/pose_manifold.h"
@@ -124,16 +125,21 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k,
   std::unique_ptr<ceres::LossFunction> accel_loss(
       config_.accel_loss_scale > 0 ? new ceres::CauchyLoss(config_.accel_loss_scale) : nullptr);
   bool accel_loss_used = false;
+  const gp::KnotBlocks knots = {prev.pose, prev.velocity, prev.acceleration,
+                                k.pose,    k.velocity,    k.acceleration};
   for (const ImuSample& s : imu) {
     const double tau = imu_.Seconds(s.t_ns);
-    window->AddResidualBlock(
-        new imu::ImuGyroMeasurement(model_, prev.t, k.t, tau, s.gyro, gyro_cov), nullptr,
-        gyro_states);
+    // The sample's state at τ, interpolated once per evaluation for its gyro and accelerometer
+    // residuals (the window's evaluation callback prepares it).
+    const auto state =
+        std::make_shared<gp::SharedStateInterpolation>(model_, prev.t, k.t, tau, knots);
+    window->shared_interpolations().Add(state);
+    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov), nullptr,
+                             gyro_states);
     ++result->imu_residuals;
     if (config_.method == LioMethod::kSingerLio) {
       window->AddResidualBlock(
-          new imu::ImuAccelMeasurement(model_, prev.t, k.t, tau, s.accel, accel_cov,
-                                       config_.gravity, accel_model),
+          new imu::ImuAccelMeasurement(state, s.accel, accel_cov, config_.gravity, accel_model),
           accel_loss.get(), accel_states);
       accel_loss_used = accel_loss != nullptr;
       ++result->imu_residuals;

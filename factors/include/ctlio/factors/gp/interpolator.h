@@ -55,6 +55,36 @@ class GpInterpolator {
   void StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
                  StateJacobian* J_k, StateJacobian* J_k1) const;
 
+  // Pose and StateRows with knot k+1 given by the interval's local variables γ_{k+1} and their
+  // Jacobians, formed once for every interpolation between the same two knots
+  // (`local` = LocalVariables(k, k1, true); gp/shared_knot_interval.h). Bit-identical to the
+  // overloads above, which form them per call.
+  void Pose(const KnotState& k, const LocalVariables& local, SE3* T, PoseJacobian* J_k,
+            PoseJacobian* J_k1) const;
+  void StateRows(const KnotState& k, const LocalVariables& local, unsigned rows, KnotState* x,
+                 StateJacobian* J_k, StateJacobian* J_k1) const;
+
+  // For residuals that read T(τ) through a row vector u = ∂e/∂δT(τ) (a point-to-plane error):
+  // u·∂δT(τ)/∂knot costs a few 1×6 products when chained row-first,
+  //   u·∂δT/∂δT_{k+1} = Σ_c (v∘Ω_0c)·P_c,  v = u·J(ξ),  P = [J⁻¹, D1·J⁻¹, D2·J⁻¹],
+  //   u·∂δT/∂ϖ_{k+1} = (v∘Ω_01)·J⁻¹ + (v∘Ω_02)·E,  u·∂δT/∂ϖ̇_{k+1} = (v∘Ω_02)·J⁻¹,
+  //   u·∂δT/∂δT_k = −(u·∂δT/∂δT_{k+1})·Ad21 + u·Ad(Exp ξ),  u·∂δT/∂ϖ_k = v∘Λ_01,
+  //   u·∂δT/∂ϖ̇_k = v∘Λ_02
+  // (the rows of Pose()'s Jacobians, associated per row; equal up to rounding, tested), where
+  // Pose() forms the 6×18 matrices (~6 dense 6×6 products) that pay only when many residuals
+  // share one τ. PoseAtTau holds the τ-dependent factors.
+  struct PoseAtTau {
+    SE3 T;    // T(τ), bit-identical to Pose()
+    Mat6 J;   // J(ξ)
+    Mat6 Ad;  // Ad(Exp ξ)
+  };
+  // `local`: LocalVariables(k, k1, with_jacobians) with AddChainProducts() for ChainPose.
+  void PoseAt(const KnotState& k, const LocalVariables& local, PoseAtTau* out) const;
+  // u·∂δT(τ)/∂[δT, δϖ, δϖ̇] of knot k and of knot k+1 (each 1×18; either may be null).
+  void ChainPose(const PoseAtTau& at, const LocalVariables& local,
+                 const Eigen::Matrix<double, 1, 6>& u, Eigen::Matrix<double, 1, 18>* J_k,
+                 Eigen::Matrix<double, 1, 18>* J_k1) const;
+
   const AxisBlockMatrix<6>& Lambda() const { return lambda_; }
   const AxisBlockMatrix<6>& Omega() const { return omega_; }
 

@@ -60,6 +60,15 @@ struct LocalVariables {
     E = 0.5 * (CurlyHatTimes(w, J_inv) - se3::CurlyHat(gamma[1]));
     Ad21 = T21.Adjoint();
   }
+
+  // D1·J⁻¹ and D2·J⁻¹ (∂γ_{k+1}/∂δT_{k+1} = [I; D1; D2]·J⁻¹), which chaining row vectors
+  // through the interpolation reads (GpInterpolator::ChainPose); formed once per interval by
+  // gp/shared_knot_interval.h. Requires with_jacobians.
+  Mat6 DJ1, DJ2;
+  void AddChainProducts() {
+    DJ1.noalias() = D1 * J_inv;
+    DJ2.noalias() = D2 * J_inv;
+  }
 };
 
 }  // namespace ctlio::gp

@@ -40,6 +40,12 @@
 //          Problem::SetParameterBlockConstant when C_mi is not estimated);
 //   biases: ∂e/∂b_k = −(1 − s)·P, ∂e/∂b_{k+1} = −s·P, P selecting b_a or b_g.
 //
+// Interpolation: each factor reads x(τ) from a gp::SharedStateInterpolation. The gyro and the
+// accelerometer residual of one sample share one (the second constructor; a window's evaluation
+// callback prepares it once per evaluation point, solvers/shared_interpolation_callback.h), so the
+// sample's interpolation is formed once; the first constructor gives a factor its own. The two
+// stay separate residual blocks because the robust loss (Cauchy) is on the accelerometer only.
+//
 // Parameter blocks:
 //   ImuGyroMeasurement:  pose_k, ϖ_k, ϖ̇_k, pose_k+1, ϖ_k+1, ϖ̇_k+1, b_k, b_k+1
 //                        (7, 6, 6, 7, 6, 6, 6, 6)
@@ -48,8 +54,11 @@
 
 #include <ceres/sized_cost_function.h>
 
+#include <memory>
+
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/imu/imu_mounting.h"
 #include "ctlio/manifolds/types.h"
 
@@ -70,12 +79,19 @@ class ImuGyroMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 
   ImuGyroMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1, double tau,
                      const Vec3& gyro, const Mat3& covariance,
                      const ImuMounting& mounting = ImuMounting());
+  // At the time of `state`, which this factor may share with the sample's accelerometer factor
+  // (adds the rows it reads to `state`).
+  ImuGyroMeasurement(std::shared_ptr<gp::SharedStateInterpolation> state, const Vec3& gyro,
+                     const Mat3& covariance, const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The state rows the residual reads (gp::StateRowBlock flags).
+  static unsigned Rows() { return gp::kAngularVelocityRows; }
+
  private:
-  gp::GpInterpolator interpolator_;
+  std::shared_ptr<const gp::SharedStateInterpolation> state_;
   double s_;  // (τ − t_k)/(t_{k+1} − t_k)
   Vec3 gyro_;
   Mat3 sqrt_information_;
@@ -91,12 +107,22 @@ class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7,
                       const Vec3& accel, const Mat3& covariance, double gravity = 9.81,
                       AccelModel accel_model = AccelModel::kBodyCentric,
                       const ImuMounting& mounting = ImuMounting());
+  // At the time of `state`, which this factor may share with the sample's gyro factor (adds the
+  // rows it reads to `state`).
+  ImuAccelMeasurement(std::shared_ptr<gp::SharedStateInterpolation> state, const Vec3& accel,
+                      const Mat3& covariance, double gravity = 9.81,
+                      AccelModel accel_model = AccelModel::kBodyCentric,
+                      const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The state rows the residual reads (gp::StateRowBlock flags): δφ and ϖ̇_v, ϖ for the exact
+  // model, ϖ_ω and ϖ̇_ω for a lever arm.
+  static unsigned Rows(AccelModel accel_model, const ImuMounting& mounting);
+
  private:
-  gp::GpInterpolator interpolator_;
+  std::shared_ptr<const gp::SharedStateInterpolation> state_;
   double s_;
   Vec3 accel_;
   Mat3 sqrt_information_;
@@ -107,6 +133,7 @@ class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7,
   bool rotated_;
   Vec3 lever_arm_;  // p
   bool lever_arm_nonzero_;
+  unsigned rows_;
 };
 
 }  // namespace ctlio::imu

@@ -7,7 +7,8 @@
 // and its Jacobians come from gp::GpInterpolator (the one place that forms a state between
 // knots) through a SharedPoseInterpolation, which the points of one firing (same τ) share and a
 // window's evaluation callback fills once per evaluation (shared_pose_interpolation.h); this
-// factor only chains de/dδT(τ) (point_to_plane.h) onto the knots:
+// factor chains de/dδT(τ) (point_to_plane.h) onto the knots, row first
+// (GpInterpolator::ChainPose):
 //
 //   de/d[δT_k, δϖ_k, δϖ̇_k] = de/dδT(τ) · ∂δT(τ)/∂(knot k)   (1×6 · 6×18), same for k+1.
 //
@@ -50,17 +51,18 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
     const bool want_k1 =
         jacobians != nullptr &&
         (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
-    SE3 T_rm_tau;
-    gp::PoseJacobian J_k, J_k1;
-    pose_->Pose(parameters, &T_rm_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
+    SharedPoseInterpolation::Scratch scratch;
+    const SharedPoseInterpolation::Result& x = pose_->Pose(parameters, want_k || want_k1, &scratch);
     if (!want_k && !want_k1) {
-      residuals[0] = lidar::PointToPlaneError(T_rm_tau, m_, nullptr);
+      residuals[0] = lidar::PointToPlaneError(x.at.T, m_, nullptr);
       return true;
     }
     Eigen::Matrix<double, 1, 6> J_tau;
-    residuals[0] = lidar::PointToPlaneError(T_rm_tau, m_, &J_tau);
-    if (want_k) WriteKnotJacobians(J_tau * J_k, parameters[0], jacobians);
-    if (want_k1) WriteKnotJacobians(J_tau * J_k1, parameters[3], jacobians + 3);
+    residuals[0] = lidar::PointToPlaneError(x.at.T, m_, &J_tau);
+    Eigen::Matrix<double, 1, 18> J_k, J_k1;
+    pose_->Chain(x, J_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
+    if (want_k) WriteKnotJacobians(J_k, parameters[0], jacobians);
+    if (want_k1) WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
     return true;
   }
 
