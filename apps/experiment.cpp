@@ -36,6 +36,7 @@
 #include <thread>
 #include <tuple>
 
+#include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
@@ -263,14 +264,10 @@ void Merge() {
 
 }  // namespace
 
-// A flag's value when it should apply: always without a preset, only if given explicitly with
-// one (the preset's value stands otherwise).
+// A flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  if (FLAGS_sim_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
-    return value;
-  }
-  return std::nullopt;
+  return ctlio::apps::Given(!FLAGS_sim_preset.empty(), flag, value);
 }
 
 int main(int argc, char** argv) {

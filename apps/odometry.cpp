@@ -20,9 +20,9 @@
 // for several methods, DIR/comparison.png; without matplotlib an SVG top view
 // (trajectory_topview.svg) instead. Several methods separated by commas run one after the other
 // and print their ATE side by side. Every write is checked (a full disk or an unwritable path is
-// an error naming the path, exit 2); the input gates of lio/input_checks.h apply (config section
-// `input:`), and --max_imu_gap_error makes IMU gaps in the dataset files an error instead of a
-// warning (README, "IMU gaps").
+// an error naming the path, exit 2); the odometry's input gates (lio/input_checks.h, config section
+// `input:`) are reported in scans.log, evaluation.txt and the summary, and --max_imu_gap_error
+// makes IMU gaps in the dataset files an error instead of a warning (README, "IMU gaps").
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
@@ -38,6 +38,7 @@
 #include <optional>
 #include <sstream>
 
+#include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
@@ -46,7 +47,6 @@
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
-#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/yaml_io.h"
 #include "lio/run_odometry.h"
@@ -97,14 +97,10 @@ namespace {
 
 using namespace ctlio;
 
-// A --sim_* flag's value when it should apply: always without a preset, only if given
-// explicitly with one (the preset's value stands otherwise).
+// A --sim_* flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  if (FLAGS_sim_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) {
-    return value;
-  }
-  return std::nullopt;
+  return apps::Given(!FLAGS_sim_preset.empty(), flag, value);
 }
 
 std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
@@ -199,34 +195,29 @@ int main(int argc, char** argv) {
     const std::vector<std::string> methods = Split(FLAGS_method);
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
-    lio::InputCheckOptions checks;
     // An `extrinsic:` written in the config wins over the dataset's (precedence in README).
     bool config_extrinsic = false;
     if (!FLAGS_config.empty()) {
-      // The `input:` section belongs to the run (readers and input gates), the rest to the
-      // odometry.
-      YAML::Node root = lio::LoadYamlFile(FLAGS_config, "odometry config");
+      const YAML::Node root = lio::LoadYamlFile(FLAGS_config, "odometry config");
       config_extrinsic = root["extrinsic"].IsDefined();
-      checks = lio::TakeInputCheckOptions(&root, FLAGS_config);
       base = lio::OdometryConfigFromYaml(root, FLAGS_config);
     }
-    if (!gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default) {
-      checks.max_imu_gap_error = FLAGS_max_imu_gap_error;
-    }
-    checks.Validate();
+    // The readers' IMU gap limit (input.max_imu_gap_error): the flag wins over the config.
+    const bool gap_flag = !gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default;
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     if (FLAGS_max_scans < 0) throw std::runtime_error("--max_scans must be >= 0 (0 = all)");
     std::vector<lioapp::RunSummary> runs;
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
     for (const std::string& m : methods) {
-      const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
-      auto source = OpenSource(checks.max_imu_gap_error);
+      lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
+      if (gap_flag) config.input.max_imu_gap_error = FLAGS_max_imu_gap_error;
+      config.Validate();
+      auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
       lioapp::RunOptions options;
       options.max_scans = static_cast<size_t>(FLAGS_max_scans);
-      options.checks = checks;
       options.extrinsic_from_config = config_extrinsic;
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       if (FLAGS_progress) {
@@ -234,7 +225,7 @@ int main(int argc, char** argv) {
           std::fprintf(stderr, "\r[%s] scan %zu/%zu  %-12s %5d assoc  %6.1f ms   ", m.c_str(), done,
                        total, lio::ScanStatusName(r.status), r.associations, r.milliseconds);
           if (r.status == lio::ScanStatus::kFailed || r.status == lio::ScanStatus::kDegenerate ||
-              r.status == lio::ScanStatus::kImuGap) {
+              r.status == lio::ScanStatus::kImuGap || r.status == lio::ScanStatus::kSuspect) {
             std::fprintf(stderr, "\n  %s at t = %.3f s: %s\n", lio::ScanStatusName(r.status),
                          1e-9 * double(r.t_ns), r.message.c_str());
           }

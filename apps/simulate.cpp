@@ -23,6 +23,7 @@
 #include <random>
 #include <sstream>
 
+#include "common/preset_flags.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
@@ -71,12 +72,10 @@ DEFINE_bool(newer_college_extrinsic, false,
 
 namespace {
 
-// A flag's value when it should apply: always without a preset, only if given explicitly with
-// one (the preset's value stands otherwise).
+// A flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  if (FLAGS_preset.empty() || !gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return value;
-  return std::nullopt;
+  return ctlio::apps::Given(!FLAGS_preset.empty(), flag, value);
 }
 
 // "a,b,c" → Vec3 (one number repeats on all axes).

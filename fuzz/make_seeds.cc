@@ -9,6 +9,7 @@
 
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_cloud_io.h"
+#include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -100,6 +101,13 @@ int main(int argc, char** argv) {
     Seed(corpus, "kitti_folder", "sim",
          Join({"0.0\n0.1\n", Read(work / "s.bin"), Read(work / "s.bin"), Read(work / "s_times.bin"),
                Read(work / "poses.txt"), "Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"}));
+    for (const std::string compression : {"none", "lz4", "bz2"}) {
+      sim::SimulatedSource bag_source(Tiny());
+      io::RosbagWriteOptions o;
+      o.compression = compression;
+      io::WriteRosbag(bag_source, (work / "s.bag").string(), o);
+      Seed(corpus, "rosbag", compression, Read(work / "s.bag"));
+    }
     for (const auto& e : fs::directory_iterator(source_dir / "data")) {
       if (e.path().extension() == ".yaml") {
         Seed(corpus, "yaml_config", e.path().filename().string(), Read(e.path()));

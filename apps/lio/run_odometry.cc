@@ -127,23 +127,14 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
               << r.angle() * 180.0 / M_PI << " deg about [" << r.axis().transpose() << "]";
   }
   if (const auto g = source.Gravity()) config.gravity = *g;
-  lio::ValidateIterationLimits(config);
-  const lio::InputCheckOptions& checks = options.checks;
-  checks.Validate();
+  // The odometry applies the input gates (config.input); the runner only reports them.
   auto odometry = lio::MakeLioOdometry(config);
   auto warn = [&](const std::string& m) {
     LOG(WARNING) << source.Name() << ": " << m;
     if (run.first_input_warning.empty()) run.first_input_warning = m;
   };
-  const bool uses_imu = config.method != lio::LioMethod::kLidarOnly;
-  const bool uses_accel =
-      config.method == lio::LioMethod::kSingerLio || config.method == lio::LioMethod::kImuInput;
-  lio::ConstantImuDetector constant_imu;
-  std::vector<lio::ImuSample> gravity_samples;
-  bool gravity_checked = !uses_accel;
   bool have_previous = false;
   int64_t previous_end = 0;
-  SE3 previous_pose;
   run.method = lio::LioMethodName(config.method);
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
@@ -155,26 +146,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
-    for (const io::ImuSample& x : frame.imu) {
-      if (const auto why = lio::CheckImuRange(x, checks)) {
-        if (++run.imu_rejected <= 5) {
-          warn("IMU sample at " + io::FormatSecondsNs(x.t_ns) + " s rejected: " + *why);
-        }
-        continue;
-      }
-      constant_imu.Add(x);
-      if (!gravity_checked) {
-        gravity_samples.push_back(x);
-        if (1e-9 * double(x.t_ns - gravity_samples.front().t_ns) >= config.gravity_init_duration) {
-          gravity_checked = true;
-          if (const auto m = lio::CheckGravityMagnitude(gravity_samples, config.gravity,
-                                                        checks.gravity_tolerance)) {
-            throw std::runtime_error(source.Name() + ": " + *m);
-          }
-        }
-      }
-      odometry->AddImu(x);
-    }
+    for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
     if (have_previous && frame.end_ns <= previous_end) {
       ++run.scans_skipped;
       warn("scan " + std::to_string(frame.index) + " skipped: its end " +
@@ -188,31 +160,15 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     scan.points = std::move(frame.cloud.points);
     scan.times_ns = std::move(frame.cloud.times_ns);
     if (scan.times_ns.empty()) scan.times_ns.assign(scan.points.size(), scan.end_ns);
-    if (have_previous) {
-      const size_t dropped = lio::DropPointsBefore(
-          previous_end, std::llround(checks.scan_time_tolerance * 1e9), &scan);
-      if (dropped > 0) {
-        run.points_dropped += int(dropped);
-        warn("scan " + std::to_string(frame.index) + ": dropped " + std::to_string(dropped) +
-             " points timed before the previous scan's end (input.scan_time_tolerance)");
-      }
-    }
-    lio::ScanResult r = odometry->AddScan(scan);
-    bool suspect = false;
-    if (uses_imu && r.status != lio::ScanStatus::kFailed && have_previous &&
-        constant_imu.ConstantSeconds() >= checks.constant_imu_duration &&
-        lio::PoseMoved(previous_pose, r.T_mr, checks)) {
-      suspect = true;
-      ++run.constant_imu_scans;
-      const std::string m = "IMU output constant for " +
-                            std::to_string(constant_imu.ConstantSeconds()) +
-                            " s while the lidar moves (frozen or dead IMU)";
-      warn("scan " + std::to_string(frame.index) + ": " + m);
-      r.message += (r.message.empty() ? "" : "; ") + m;
+    const lio::ScanResult r = odometry->AddScan(scan);
+    run.imu_rejected += r.imu_rejected;
+    run.points_dropped += r.points_dropped;
+    if (r.status == lio::ScanStatus::kSuspect) ++run.constant_imu_scans;
+    if (r.imu_rejected > 0 || r.points_dropped > 0 || r.status == lio::ScanStatus::kSuspect) {
+      warn("scan " + std::to_string(frame.index) + ": " + r.message);
     }
     have_previous = true;
     previous_end = frame.end_ns;
-    if (r.status != lio::ScanStatus::kFailed) previous_pose = r.T_mr;
     ++done;
     ms.push_back(r.milliseconds);
     switch (r.status) {
@@ -241,7 +197,6 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       }
     }
     run.scans.push_back(r);
-    run.suspect.push_back(suspect);
     if (options.progress) options.progress(done, total, r);
   }
   // The first scan (map creation) is not a registration: keep it out of the latency figures.
@@ -359,18 +314,19 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
 void WriteScanLog(const std::string& path, const RunSummary& run) {
   std::ofstream f = io::OpenForWriting(path);
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
-       "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z "
-       "degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info degen_prior_info message\n";
+       "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z imu_rejected "
+       "points_dropped degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info "
+       "degen_prior_info message\n";
   f << std::setprecision(12);
   for (size_t i = 0; i < run.scans.size(); ++i) {
     const lio::ScanResult& r = run.scans[i];
-    const bool suspect = i < run.suspect.size() && run.suspect[i];
     const Vec3 p = r.T_mr.translation();
-    f << 1e-9 * double(r.t_ns) << ' ' << (suspect ? "suspect" : lio::ScanStatusName(r.status))
-      << ' ' << r.keypoints << ' ' << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds
-      << ' ' << r.solver_iterations << ' ' << r.final_cost << ' ' << r.milliseconds << ' '
-      << r.ms_preprocess << ' ' << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' '
-      << r.ms_marginalize << ' ' << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ';
+    f << 1e-9 * double(r.t_ns) << ' ' << lio::ScanStatusName(r.status) << ' ' << r.keypoints << ' '
+      << r.associations << ' ' << r.imu_residuals << ' ' << r.rounds << ' ' << r.solver_iterations
+      << ' ' << r.final_cost << ' ' << r.milliseconds << ' ' << r.ms_preprocess << ' '
+      << r.ms_associate << ' ' << r.ms_solve << ' ' << r.ms_map << ' ' << r.ms_marginalize << ' '
+      << r.cpu_ms << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << r.imu_rejected << ' '
+      << r.points_dropped << ' ';
     const lio::DegeneracyReport& d = r.degeneracy;
     if (d.analysed) {
       f << d.translation_eigenvalues[0] << ' ' << d.rotation_eigenvalues[0] << ' '

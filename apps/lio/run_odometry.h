@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "ctlio/io/dataset.h"
-#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lioapp {
@@ -26,8 +25,6 @@ struct RunOptions {
   double trajectory_rate_hz = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
-  // Plausibility gates applied to the source's data before the odometry sees them.
-  lio::InputCheckOptions checks;
 };
 
 struct AteResult {
@@ -54,11 +51,11 @@ struct RunSummary {
   // their status (with an IMU they stay `ok`: the IMU and the prior carry those directions).
   int degenerate_direction_scans = 0;
   std::string first_failure;  // message of the first failed scan
-  // Input gates (lio/input_checks.h): samples rejected, points dropped for their time, scans
-  // skipped (end not after the previous one), scans estimated with a frozen IMU while the lidar
-  // moved (marked "suspect" in the scan log; they make the run a failure).
+  // Input gates (lio/input_checks.h, applied by the odometry; totals of the ScanResults):
+  // samples rejected, points dropped for their time, scans estimated with a frozen IMU while the
+  // lidar moved (status "suspect"; they make the run a failure); and the runner's own recovery:
+  // scans skipped because their end is not after the previous one (the odometry would throw).
   int imu_rejected = 0, points_dropped = 0, scans_skipped = 0, constant_imu_scans = 0;
-  std::vector<bool> suspect;                           // per entry of `scans`
   std::string first_input_warning;                     // message of the first of the above
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
   double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan
@@ -97,12 +94,12 @@ std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
 void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
 
-// Per-scan log (the write is checked: an error names the path): t, status (or "suspect"),
-// keypoints, associations, imu residuals, rounds, solver iterations, final cost, ms (total and
-// per stage), cpu ms, position, the degeneracy analysis (normalised smallest eigenvalue of the
-// translation and rotation blocks, number of degenerate directions, the least constrained one
-// "t:x,y,z"/"r:x,y,z" in the body frame, the lidar's and the prior's information along it; "-"
-// where not analysed), message.
+// Per-scan log (the write is checked: an error names the path): t, status, keypoints,
+// associations, imu residuals, rounds, solver iterations, final cost, ms (total and per stage),
+// CPU ms, position, IMU samples rejected, points dropped, the degeneracy analysis (normalised
+// smallest eigenvalue of the translation and rotation blocks, number of degenerate directions,
+// the least constrained one "t:x,y,z"/"r:x,y,z" in the body frame, the lidar's and the prior's
+// information along it; "-" where not analysed), message.
 void WriteScanLog(const std::string& path, const RunSummary& run);
 
 // Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file with

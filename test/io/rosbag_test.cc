@@ -209,6 +209,82 @@ TEST(Rosbag, BadBagsAndLayoutsGiveClearErrors) {
   EXPECT_EQ(f.imu.size(), 10u);  // 10 ms … 100 ms ≤ the scan end (100 ms + 9 µs)
 }
 
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Overwrites the value of every header field `name=` (the bytes after it) with `value`.
+std::string PatchField(std::string bytes, const std::string& name, const std::string& value) {
+  size_t found = 0;
+  for (size_t at = bytes.find(name + "="); at != std::string::npos;
+       at = bytes.find(name + "=", at + 1), ++found) {
+    bytes.replace(at + name.size() + 1, value.size(), value);
+  }
+  EXPECT_GT(found, 0u) << name;
+  return bytes;
+}
+
+std::string U32(uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+std::string U64(uint64_t v) { return std::string(reinterpret_cast<const char*>(&v), 8); }
+
+// Corrupt lengths, offsets and counts are caught before the bag library sees them (it trusts
+// them: a multi-GB allocation or a read outside the chunk), naming the bag and the byte.
+TEST(Rosbag, BagStructureIsCheckedBeforeTheLibraryReadsIt) {
+  const fs::path d = testing::FreshTempDir("rosbag_structure");
+  const std::string good = (d / "good.bag").string();
+  {
+    sim::SimulatedSource source(SmallSim());
+    WriteRosbag(source, good);
+  }
+  const std::string bytes = ReadBytes(good);
+  auto expect_error = [&](const std::string& name, const std::string& corrupt,
+                          const std::vector<std::string>& needles) {
+    const std::string path = (d / name).string();
+    std::ofstream(path, std::ios::binary) << corrupt;
+    std::vector<std::string> all = {name, "not a valid ROS 1 bag"};
+    all.insert(all.end(), needles.begin(), needles.end());
+    ExpectError([&] { RosbagSource s(path); }, all);
+  };
+  // An uncompressed chunk declaring 4 GB (the library would allocate them).
+  expect_error("chunk_size.bag", PatchField(bytes, "size", U32(0xFFFFFFF0u)),
+               {"uncompressed chunk", "declares 4294967280"});
+  expect_error("index_pos.bag", PatchField(bytes, "index_pos", U64(bytes.size() + 7)),
+               {"index position is not a record"});
+  expect_error("version.bag", PatchField(bytes, "ver", U32(2)), {"version is not 1"});
+  // The first index entry's offset (header fields conn, count, op, ver; then the data length and
+  // 12-byte entries: time, offset) pointing far beyond its chunk.
+  std::string offset = bytes;
+  const size_t ver = offset.find("ver=", offset.find(std::string("op=") + char(0x04)));
+  ASSERT_NE(ver, std::string::npos);
+  offset.replace(ver + 4 + 4 + 4 + 8, 4, U32(0xFFFFFF00u));
+  expect_error("index_offset.bag", offset, {"index entry 0 points outside its chunk"});
+  expect_error("truncated.bag", bytes.substr(0, bytes.size() - 3), {"does not fit"});
+  // A message type whose md5sum is not the reader's: an error, not a null message.
+  const std::string md5 = PatchField(bytes, "md5sum", "00000000");
+  std::ofstream((d / "md5.bag").string(), std::ios::binary) << md5;
+  ExpectError([&] { RosbagSource s((d / "md5.bag").string()); },
+              {"md5.bag", "is not a sensor_msgs/", "md5sum 00000000"});
+}
+
+// Every input the bag fuzz target ever stopped on (fuzz/regressions/rosbag_*): a clear error or a
+// bag read to the end, never a crash.
+TEST(Rosbag, FuzzRegressionsGiveAnErrorOrRead) {
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(CTLIO_FUZZ_REGRESSIONS_DIR)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("rosbag_", 0) != 0) continue;
+    ++files;
+    try {
+      RosbagSource source(e.path().string());
+      ReadAll(source);
+    } catch (const std::runtime_error& err) {
+      EXPECT_THAT(err.what(), HasSubstr(e.path().string()));
+    }
+  }
+  EXPECT_GT(files, 0u);
+}
+
 TEST(Rosbag, OdometryBagHoldsTheTrajectory) {
   const fs::path d = testing::FreshTempDir("rosbag_odometry");
   std::vector<StampedPose> trajectory;

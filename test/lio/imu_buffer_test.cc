@@ -1,6 +1,6 @@
-// ImuBuffer (SPEC §3, §4): the odometry's single entry point for IMU samples — order and
-// finiteness checks, duplicate recovery — and the zero-order-hold segments, gaps, samples in an
-// interval and trimming the pipelines read.
+// ImuBuffer (SPEC §3, §4): the odometry's single entry point for IMU samples — order check, the
+// input gates (finiteness, range, constant output), duplicate recovery — and the zero-order-hold
+// segments, gaps, samples in an interval and trimming the pipelines read.
 #include "ctlio/solvers/lio/imu_buffer.h"
 
 #include <gtest/gtest.h>
@@ -28,16 +28,46 @@ ImuBuffer Buffer(const std::vector<double>& times) {
   return b;
 }
 
-TEST(ImuBuffer, RejectsBackwardsAndNonFiniteDropsDuplicates) {
+TEST(ImuBuffer, ThrowsOnBackwardsRejectsNonFiniteDropsDuplicates) {
   ImuBuffer b = Buffer({0.00, 0.01});
   EXPECT_THROW(b.AddImu(Sample(0.005, 9)), std::invalid_argument);
   ImuSample bad = Sample(0.02, 0);
   bad.accel.x() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(b.AddImu(bad), std::invalid_argument);
-  b.AddImu(Sample(0.01, 7));  // same stamp: the first sample is kept
+  EXPECT_FALSE(b.AddImu(bad));  // refused: not stored, counted, reported once
+  bad.accel.x() = std::numeric_limits<double>::infinity();
+  bad.t_ns += 1'000'000;
+  EXPECT_FALSE(b.AddImu(bad));
+  EXPECT_EQ(b.rejected(), 2u);
+  const ImuBuffer::Rejections r = b.TakeRejections();
+  EXPECT_EQ(r.count, 2u);
+  EXPECT_NE(r.first.find("not finite"), std::string::npos) << r.first;
+  EXPECT_EQ(b.TakeRejections().count, 0u);  // taken
+  EXPECT_TRUE(b.AddImu(Sample(0.01, 7)));   // same stamp: the first sample is kept
   EXPECT_EQ(b.duplicates(), 1u);
   ASSERT_EQ(b.samples().size(), 2u);
   EXPECT_EQ(b.samples().back().gyro.x(), 1.0);
+}
+
+TEST(ImuBuffer, RangeGateAndConstantOutput) {
+  InputCheckOptions checks;
+  checks.max_gyro = 2.0;
+  checks.max_accel = 20.0;
+  ImuBuffer b(checks);
+  b.SetOrigin(kOrigin);
+  EXPECT_TRUE(b.AddImu(Sample(0.00, 1.0)));   // |ω| = √3 rad/s
+  EXPECT_FALSE(b.AddImu(Sample(0.01, 2.0)));  // |ω| = 2√3 rad/s > 2
+  EXPECT_NE(b.TakeRejections().first.find("input.max_gyro"), std::string::npos);
+  ImuSample s = Sample(0.02, 1.0);
+  s.accel = Vec3(0, 0, 25);
+  EXPECT_FALSE(b.AddImu(s));
+  EXPECT_NE(b.TakeRejections().first.find("input.max_accel"), std::string::npos);
+  // Accepted samples identical to the first: the constant run grows with their time span.
+  EXPECT_TRUE(b.AddImu(Sample(0.03, 1.0)));
+  EXPECT_TRUE(b.AddImu(Sample(0.05, 1.0)));
+  EXPECT_NEAR(b.ConstantSeconds(), 0.05, 1e-12);
+  EXPECT_TRUE(b.AddImu(Sample(0.06, 1.0 + 1e-9)));  // any change restarts it
+  EXPECT_EQ(b.ConstantSeconds(), 0.0);
+  EXPECT_EQ(b.samples().size(), 4u);
 }
 
 TEST(ImuBuffer, SegmentsHoldEachSampleUntilTheNext) {

@@ -69,7 +69,8 @@ TEST(LioPipeline, BadInputThrowsWithReason) {
   EXPECT_EQ(odometry->duplicate_imu_samples(), 1u);
   s.t_ns = 2000;
   s.accel.x() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(odometry->AddImu(s), std::invalid_argument);
+  EXPECT_FALSE(odometry->AddImu(s));  // refused by the input gate, counted
+  EXPECT_EQ(odometry->rejected_imu_samples(), 1u);
 
   LidarScan scan;
   scan.begin_ns = 0;

@@ -6,11 +6,14 @@
 #include <vector>
 
 #include "ctlio/factors/imu/gravity_initialization.h"
+#include "ctlio/solvers/lio/input_checks.h"
 
 namespace ctlio::lio {
 
 bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig& config, Mat3* C_mi,
                        std::string* message) {
+  const bool uses_accel =
+      config.method == LioMethod::kSingerLio || config.method == LioMethod::kImuInput;
   const std::vector<ImuSample> samples(imu.samples().begin(), imu.samples().end());
   if (samples.empty()) {
     *message = "gravity initialisation: no IMU samples before the first scan end";
@@ -20,6 +23,20 @@ bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig&
   const int64_t t0_ns =
       std::max(samples.front().t_ns,
                end_ns - static_cast<int64_t>(std::llround(config.gravity_init_duration * 1e9)));
+  // Input gate (input_checks.h): an accelerometer in g, or columns swapped, shows as a mean
+  // specific force far from the configured gravity. Named as such before the stillness tests of
+  // imu::InitializeGravity, whose 0.3 m/s² limit would report it as mere motion or bias.
+  if (uses_accel) {
+    std::vector<ImuSample> window;
+    for (const ImuSample& s : samples) {
+      if (s.t_ns >= t0_ns && s.t_ns <= end_ns) window.push_back(s);
+    }
+    if (const auto m =
+            CheckGravityMagnitude(window, config.gravity, config.input.gravity_tolerance)) {
+      *message = "gravity initialisation: " + *m;
+      return false;
+    }
+  }
   imu::GravityInitializationOptions options;
   options.gravity = config.gravity;
   options.max_block_accel_deviation = config.gravity_init_max_std;

@@ -1,20 +1,18 @@
 #include "ctlio/solvers/lio/imu_buffer.h"
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace ctlio::lio {
 
-void ImuBuffer::AddImu(const ImuSample& s) {
-  if (!s.gyro.allFinite() || !s.accel.allFinite()) {
-    throw std::invalid_argument(
-        "LioOdometry::AddImu: non-finite IMU sample at t = " + std::to_string(s.t_ns) + " ns");
-  }
+bool ImuBuffer::AddImu(const ImuSample& s) {
   if (!samples_.empty()) {
     if (s.t_ns == samples_.back().t_ns) {
       ++duplicates_;  // documented recovery: keep the first of two equal stamps
-      return;
+      return true;
     }
     if (s.t_ns < samples_.back().t_ns) {
       throw std::invalid_argument("LioOdometry::AddImu: IMU time goes backwards (" +
@@ -22,7 +20,26 @@ void ImuBuffer::AddImu(const ImuSample& s) {
                                   std::to_string(samples_.back().t_ns) + " ns)");
     }
   }
+  if (const auto why = CheckImuRange(s, checks_)) {
+    // Documented recovery: the zero-order hold of the previous sample bridges the hole.
+    ++rejected_;
+    if (pending_.count++ == 0) {
+      std::ostringstream m;
+      m << "IMU sample at " << std::fixed << std::setprecision(9) << 1e-9 * double(s.t_ns)
+        << " s rejected: " << *why;
+      pending_.first = m.str();
+    }
+    return false;
+  }
+  constant_.Add(s);
   samples_.push_back(s);
+  return true;
+}
+
+ImuBuffer::Rejections ImuBuffer::TakeRejections() {
+  Rejections r = std::move(pending_);
+  pending_ = Rejections();
+  return r;
 }
 
 std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap) const {

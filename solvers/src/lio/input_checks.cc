@@ -1,13 +1,8 @@
 #include "ctlio/solvers/lio/input_checks.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
-#include <map>
 #include <sstream>
 #include <stdexcept>
-
-#include "ctlio/solvers/lio/yaml_io.h"
 
 namespace ctlio::lio {
 
@@ -30,66 +25,16 @@ void InputCheckOptions::Validate() const {
           "max_imu_gap_error must be in [0, 1e6) s (0 = off)");
 }
 
-InputCheckOptions TakeInputCheckOptions(YAML::Node* root, const std::string& source) {
-  InputCheckOptions o;
-  if (!root->IsMap() || !(*root)["input"]) return o;
-  const YAML::Node section = (*root)["input"];
-  if (!section.IsMap()) {
-    throw std::runtime_error(YamlWhere(source, section.Mark()) + ": 'input' must be a mapping");
-  }
-  const std::map<std::string, double*> keys = {{"max_gyro", &o.max_gyro},
-                                               {"max_accel", &o.max_accel},
-                                               {"gravity_tolerance", &o.gravity_tolerance},
-                                               {"constant_imu_duration", &o.constant_imu_duration},
-                                               {"moving_translation", &o.moving_translation},
-                                               {"moving_rotation", &o.moving_rotation},
-                                               {"scan_time_tolerance", &o.scan_time_tolerance},
-                                               {"max_imu_gap_error", &o.max_imu_gap_error}};
-  for (const auto& kv : section) {
-    const std::string key = kv.first.as<std::string>("");
-    const auto it = keys.find(key);
-    if (it == keys.end()) {
-      throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key 'input." + key +
-                               "'");
-    }
-    try {
-      *it->second = kv.second.as<double>();
-    } catch (const YAML::Exception&) {
-      throw std::runtime_error(YamlWhere(source, kv.second.Mark()) + ": input." + key +
-                               " is not a number");
-    }
-  }
-  try {
-    o.Validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(YamlWhere(source, section.Mark()) + ": " + e.what());
-  }
-  root->remove("input");
-  return o;
-}
-
-void ValidateIterationLimits(const OdometryConfig& config) {
-  if (config.frontend.max_iterations > 100) {
-    throw std::invalid_argument("lidar_frontend.max_iterations " +
-                                std::to_string(config.frontend.max_iterations) +
-                                " exceeds 100 association rounds per scan");
-  }
-  if (config.frontend.solver_iterations > 1000) {
-    throw std::invalid_argument("lidar_frontend.solver_iterations " +
-                                std::to_string(config.frontend.solver_iterations) +
-                                " exceeds 1000 solver iterations per round");
-  }
-}
-
 std::optional<std::string> CheckImuRange(const ImuSample& s, const InputCheckOptions& o) {
+  if (!s.gyro.allFinite() || !s.accel.allFinite()) return std::string("not finite");
   const double w = s.gyro.norm(), f = s.accel.norm();
   std::ostringstream m;
-  if (!std::isfinite(w) || w > o.max_gyro) {
+  if (!(w <= o.max_gyro)) {
     m << "|gyro| " << w << " rad/s beyond the physical range " << o.max_gyro
       << " rad/s (input.max_gyro)";
     return m.str();
   }
-  if (!std::isfinite(f) || f > o.max_accel) {
+  if (!(f <= o.max_accel)) {
     m << "|accel| " << f << " m/s² beyond the physical range " << o.max_accel
       << " m/s² (input.max_accel)";
     return m.str();
@@ -122,11 +67,11 @@ std::optional<std::string> CheckGravityMagnitude(const std::vector<ImuSample>& s
   return m.str();
 }
 
-size_t DropPointsBefore(int64_t previous_end_ns, int64_t tolerance_ns, LidarScan* scan) {
+size_t DropPointsOutside(int64_t lo_ns, int64_t hi_ns, LidarScan* scan) {
   size_t kept = 0;
   const size_t n = scan->points.size();
   for (size_t i = 0; i < n; ++i) {
-    if (scan->times_ns[i] < previous_end_ns - tolerance_ns) continue;
+    if (scan->times_ns[i] < lo_ns || scan->times_ns[i] > hi_ns) continue;
     scan->points[kept] = scan->points[i];
     scan->times_ns[kept] = scan->times_ns[i];
     ++kept;

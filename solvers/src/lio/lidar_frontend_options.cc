@@ -29,6 +29,10 @@ void LidarFrontendOptions::Validate() const {
   require(max_neighbours >= min_neighbours, "max_neighbours must be >= min_neighbours");
   require(max_plane_distance > 0.0, "max_plane_distance must be positive");
   require(max_iterations >= 1 && solver_iterations >= 1, "iteration counts must be >= 1");
+  // Upper bounds: with zero convergence thresholds the solver runs to these on every scan, so an
+  // unbounded value is a run that never ends.
+  require(max_iterations <= 100, "max_iterations must be <= 100 association rounds per scan");
+  require(solver_iterations <= 1000, "solver_iterations must be <= 1000 per round");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
   require(point_noise_sigma > 0.0, "point_noise_sigma must be positive");

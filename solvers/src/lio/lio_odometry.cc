@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
+#include "ctlio/solvers/lio/input_checks.h"
 
 namespace ctlio::lio {
 
@@ -50,6 +52,11 @@ void SortByTime(std::vector<TimedPoint>* points) {
   }
 }
 
+// Appends a note to the scan's message ("; "-separated).
+void AddNote(ScanResult* result, const std::string& note) {
+  result->message += (result->message.empty() ? "" : "; ") + note;
+}
+
 std::vector<Vec3> Positions(const std::vector<TimedPoint>& points) {
   std::vector<Vec3> out;
   out.reserve(points.size());
@@ -61,6 +68,7 @@ std::vector<Vec3> Positions(const std::vector<TimedPoint>& points) {
 
 LioOdometry::LioOdometry(const OdometryConfig& config)
     : config_(Validated(config)),
+      imu_(config_.input),
       frontend_(config.frontend),
       window_(WindowOptions(config)),
       registration_(config.frontend, config.min_associations),
@@ -86,16 +94,20 @@ std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double ra
   return out;
 }
 
-ScanResult LioOdometry::AddScan(const LidarScan& scan) {
+ScanResult LioOdometry::AddScan(const LidarScan& input) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMs();
-  CheckScan(scan);
+  CheckScan(input);
   if (!have_origin_) {
-    imu_.SetOrigin(scan.begin_ns);
+    imu_.SetOrigin(input.begin_ns);
     have_origin_ = true;
   }
-  const PreparedScan prepared = PrepareScan(scan);
   ScanResult result;
+  LidarScan trimmed;
+  std::string dropped_note;  // added to the message once the scan is processed
+  const LidarScan& scan = DropPointsOutsideInterval(input, &trimmed, &dropped_note);
+  result.points_dropped = static_cast<int>(input.points.size() - scan.points.size());
+  const PreparedScan prepared = PrepareScan(scan);
   result.ms_preprocess = MsSince(start);
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
@@ -111,11 +123,52 @@ ScanResult LioOdometry::AddScan(const LidarScan& scan) {
     result.message = e.what();
     if (!initialised_) last_scan_end_ns_ = scan.end_ns;
   }
+  if (!dropped_note.empty()) AddNote(&result, dropped_note);
+  const ImuBuffer::Rejections rejected = imu_.TakeRejections();
+  if (rejected.count > 0) {
+    result.imu_rejected = static_cast<int>(rejected.count);
+    AddNote(&result,
+            std::to_string(rejected.count) +
+                " IMU sample(s) rejected since the previous scan (first: " + rejected.first + ")");
+  }
+  CheckFrozenImu(&result);
   imu_.Trim(imu_.Seconds(last_scan_end_ns_) - 0.5);
   result.milliseconds = MsSince(start);
   result.cpu_ms = ThreadCpuMs() - cpu_start;
   results_.push_back(result);
   return result;
+}
+
+const LidarScan& LioOdometry::DropPointsOutsideInterval(const LidarScan& scan, LidarScan* trimmed,
+                                                        std::string* note) const {
+  const int64_t tolerance = std::llround(config_.input.scan_time_tolerance * 1e9);
+  const int64_t begin = initialised_ ? last_scan_end_ns_ : scan.begin_ns;
+  const int64_t lo = begin - tolerance, hi = scan.end_ns + tolerance;
+  const auto outside = [&](int64_t t) { return t < lo || t > hi; };
+  if (std::none_of(scan.times_ns.begin(), scan.times_ns.end(), outside)) return scan;
+  *trimmed = scan;
+  const size_t dropped = DropPointsOutside(lo, hi, trimmed);
+  std::ostringstream m;
+  m << std::fixed << std::setprecision(9) << "dropped " << dropped << " of " << scan.points.size()
+    << " points timed outside [" << 1e-9 * double(begin) << ", " << 1e-9 * double(scan.end_ns)
+    << "] s by more than input.scan_time_tolerance " << config_.input.scan_time_tolerance << " s";
+  *note = m.str();
+  return *trimmed;
+}
+
+void LioOdometry::CheckFrozenImu(ScanResult* result) {
+  if (result->status == ScanStatus::kFailed) return;
+  const double constant = imu_.ConstantSeconds();
+  if (uses_imu() && have_last_pose_ && constant >= config_.input.constant_imu_duration &&
+      PoseMoved(last_pose_, result->T_mr, config_.input)) {
+    std::ostringstream m;
+    m << "IMU output constant for " << constant
+      << " s while the lidar moves (frozen or dead IMU; input.constant_imu_duration)";
+    result->status = ScanStatus::kSuspect;
+    AddNote(result, m.str());
+  }
+  last_pose_ = result->T_mr;
+  have_last_pose_ = true;
 }
 
 void LioOdometry::Initialise(const PreparedScan& scan, ScanResult* result) {
@@ -205,8 +258,9 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   for (const size_t i : kept) {
     TimedPoint p;
     p.point = config_.T_imu_lidar * scan.points[i];
-    // Points are registered between the previous knot and this one; a time outside (clock
-    // jitter of the driver) is clamped rather than extrapolated.
+    // Points are registered between the previous knot and this one; a time outside by less than
+    // input.scan_time_tolerance (clock jitter of the driver; the rest was dropped and counted in
+    // DropPointsOutsideInterval) is clamped onto the interval rather than extrapolated.
     p.time = std::clamp(imu_.Seconds(scan.times_ns[i]), t_prev, prepared.t_end);
     raw.push_back(p);
   }

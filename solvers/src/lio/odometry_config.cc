@@ -83,6 +83,8 @@ const char* ScanStatusName(ScanStatus status) {
       return "imu_gap";
     case ScanStatus::kFailed:
       return "failed";
+    case ScanStatus::kSuspect:
+      return "suspect";
   }
   return "?";
 }
@@ -92,6 +94,7 @@ void OdometryConfig::Validate() const {
     if (!ok) throw std::invalid_argument(std::string("OdometryConfig: ") + what);
   };
   frontend.Validate();
+  input.Validate();
   require((qc.array() > 0).all(), "gp.qc must be positive on every axis");
   require((alpha.array() >= 0).all(), "gp.alpha must be >= 0 on every axis");
   require(accel_variance > 0 && gyro_variance > 0, "imu variances must be positive");
@@ -135,7 +138,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     const std::string key = kv.first.as<std::string>();
     const YAML::Node& v = kv.second;
     const std::string section = where + key;
-    if (top == nullptr && (key == "method" || key == "extrinsic" || key == "per_method")) {
+    if (top == nullptr &&
+        (key == "method" || key == "extrinsic" || key == "input" || key == "per_method")) {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": '" + section +
                                "' cannot be set per method");
     }
@@ -198,6 +202,17 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"remap", SetFromYaml(&c->degeneracy.remap)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
+    } else if (key == "input") {
+      InputCheckOptions& o = c->input;
+      ReadSection(v, section, source,
+                  {{"max_gyro", SetFromYaml(&o.max_gyro)},
+                   {"max_accel", SetFromYaml(&o.max_accel)},
+                   {"gravity_tolerance", SetFromYaml(&o.gravity_tolerance)},
+                   {"constant_imu_duration", SetFromYaml(&o.constant_imu_duration)},
+                   {"moving_translation", SetFromYaml(&o.moving_translation)},
+                   {"moving_rotation", SetFromYaml(&o.moving_rotation)},
+                   {"scan_time_tolerance", SetFromYaml(&o.scan_time_tolerance)},
+                   {"max_imu_gap_error", SetFromYaml(&o.max_imu_gap_error)}});
     } else {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + section +
                                "'");

@@ -15,6 +15,7 @@
 #include <map>
 #include <queue>
 
+#include "ctlio/io/bag_structure.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/pointcloud2.h"
 
@@ -65,6 +66,19 @@ bool FindStaticTransform(const std::vector<geometry_msgs::TransformStamped>& edg
     }
   }
   return false;
+}
+
+// The message as M; a message whose type or md5sum is not M's (a corrupt or foreign connection
+// header) is an error, not a null pointer.
+template <class M>
+boost::shared_ptr<M> Instantiate(const rosbag::MessageInstance& m, const std::string& where) {
+  boost::shared_ptr<M> msg = m.instantiate<M>();
+  if (!msg) {
+    throw std::runtime_error(where + "message on " + m.getTopic() + " is not a " +
+                             ros::message_traits::datatype<M>() + " (type " + m.getDataType() +
+                             ", md5sum " + m.getMD5Sum() + ")");
+  }
+  return msg;
 }
 
 std::string PickTopic(const std::map<std::string, std::string>& topics, const std::string& type,
@@ -166,6 +180,8 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
   s.options = options;
   if (!std::filesystem::is_regular_file(path)) s.Fail("file not found");
   if (!IsRosbagFile(path)) s.Fail("not a ROS 1 bag (no '#ROSBAG V2.0' header)");
+  // The bag library trusts the file's lengths and offsets: check them first (bag_structure.h).
+  CheckBagStructure(path);
   std::map<std::string, std::string> topics;
   try {
     s.bag.open(path, rosbag::bagmode::Read);
@@ -197,11 +213,12 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     rosbag::View lidar(s.bag, rosbag::TopicQuery(s.lidar_topic));
     s.num_scans = lidar.size();
     if (lidar.begin() != lidar.end()) {
-      s.lidar_frame = lidar.begin()->instantiate<sensor_msgs::PointCloud2>()->header.frame_id;
+      s.lidar_frame =
+          Instantiate<sensor_msgs::PointCloud2>(*lidar.begin(), path + ": ")->header.frame_id;
     }
     rosbag::View imu(s.bag, rosbag::TopicQuery(s.imu_topic));
     if (imu.begin() != imu.end()) {
-      s.imu_frame = imu.begin()->instantiate<sensor_msgs::Imu>()->header.frame_id;
+      s.imu_frame = Instantiate<sensor_msgs::Imu>(*imu.begin(), path + ": ")->header.frame_id;
     }
     // Extrinsic: /tf_static, then the preset, then a shared frame (header comment).
     std::vector<geometry_msgs::TransformStamped> edges;
@@ -224,7 +241,7 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
         topics.at(options.ground_truth_topic) == "nav_msgs/Odometry") {
       rosbag::View gt(s.bag, rosbag::TopicQuery(options.ground_truth_topic));
       for (const rosbag::MessageInstance& m : gt) {
-        const auto o = m.instantiate<nav_msgs::Odometry>();
+        const auto o = Instantiate<nav_msgs::Odometry>(m, path + ": ");
         s.ground_truth.push_back({int64_t(o->header.stamp.toNSec()), FromRos(o->pose.pose)});
       }
       std::stable_sort(s.ground_truth.begin(), s.ground_truth.end(),
@@ -296,9 +313,8 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
   s.gyro = Vec3(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
   s.accel = options.accel_scale *
             Vec3(m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
-  if (!s.gyro.allFinite() || !s.accel.allFinite()) {
-    throw std::runtime_error(Where(imu_topic, imu_messages) + "non-finite IMU sample");
-  }
+  // Plausibility (finiteness, physical range) is the odometry's input gate (ImuBuffer::AddImu),
+  // one place for every reader: a non-finite sample is rejected and counted there.
   // sensor_msgs/Imu is m/s², but some drivers publish g (Livox's built-in IMU): a mean specific
   // force near 1 over the first samples is flagged once, with the remedy.
   if (imu_messages <= 200) {
@@ -352,9 +368,9 @@ void RosbagSource::Impl::ReadOne() {
     const rosbag::MessageInstance& m = *it;
     bytes += m.size();
     if (m.getTopic() == imu_topic) {
-      AddImu(*m.instantiate<sensor_msgs::Imu>());
+      AddImu(*Instantiate<sensor_msgs::Imu>(m, Where(imu_topic, imu_messages + 1)));
     } else {
-      AddScan(*m.instantiate<sensor_msgs::PointCloud2>());
+      AddScan(*Instantiate<sensor_msgs::PointCloud2>(m, Where(lidar_topic, lidar_messages + 1)));
     }
     ++it;
     exhausted = it == view->end();

@@ -20,7 +20,8 @@ namespace ctlio::lio {
 class ContinuousLidarTerm final : public LidarTerm {
  public:
   // Knots k (at t_k) and k1 (at t_k1 > t_k) are states of `window`; keypoints in the robot
-  // frame with times in [t_k, t_k1] (a time outside is clamped, never extrapolated). The
+  // frame with times in [t_k, t_k1] (LioOdometry drops or clamps the points outside before they
+  // get here; the clamp inside only absorbs rounding, never extrapolates). The
   // keypoints are referenced, not copied. Registers its firings with the window's callback.
   ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
                       const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,

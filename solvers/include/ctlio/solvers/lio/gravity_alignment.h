@@ -11,7 +11,9 @@
 namespace ctlio::lio {
 
 // Uses the last config.gravity_init_duration seconds of IMU up to t_end (odometry seconds, the
-// first scan's end). Returns false with a message (no samples, not still) instead of throwing.
+// first scan's end). Returns false with a message (no samples, not still, and — for the methods
+// that use the accelerometer — a mean specific force not within config.input.gravity_tolerance of
+// config.gravity: units or axes that cannot be right) instead of throwing.
 bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig& config, Mat3* C_mi,
                        std::string* message);
 

@@ -1,5 +1,6 @@
 // The IMU samples the odometry has received and not yet consumed (SPEC §3, §4): the single entry
-// point for IMU data (AddImu checks order and finiteness), the samples and the zero-order-hold
+// point for IMU data (AddImu checks order and applies the input gates of input_checks.h: range,
+// finiteness, how long the output has stayed constant), the samples and the zero-order-hold
 // signal over an interval, the longest hole in the stream, and trimming of what is no longer
 // needed. Times are int64 ns at the interface and double seconds relative to the odometry's
 // origin (the first scan's start) inside.
@@ -7,8 +8,10 @@
 
 #include <cstdint>
 #include <deque>
+#include <string>
 #include <vector>
 
+#include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lio {
@@ -23,9 +26,22 @@ struct ImuSegment {
 
 class ImuBuffer {
  public:
-  // Throws std::invalid_argument if the sample is not finite or older than the previous one;
-  // a repeated timestamp is dropped (the first sample is kept) and counted in duplicates().
-  void AddImu(const ImuSample& sample);
+  explicit ImuBuffer(const InputCheckOptions& checks = {}) : checks_(checks) {}
+
+  // Throws std::invalid_argument if the sample is older than the previous one; a repeated
+  // timestamp is dropped (the first sample is kept) and counted in duplicates(). A sample that
+  // cannot be physical (not finite, or beyond input.max_gyro / max_accel) is rejected: not
+  // stored, counted in rejected() and in TakeRejections(); returns false then.
+  bool AddImu(const ImuSample& sample);
+
+  // Samples rejected since the previous call, and the reason of the first of them.
+  struct Rejections {
+    size_t count = 0;
+    std::string first;  // "IMU sample at <t> s rejected: <reason>"
+  };
+  Rejections TakeRejections();
+  // How long the accepted IMU output has stayed bit-identical, up to the newest sample [s].
+  double ConstantSeconds() const { return constant_.ConstantSeconds(); }
 
   // Odometry time: seconds since origin_ns (set once, at the first scan).
   void SetOrigin(int64_t origin_ns) { origin_ns_ = origin_ns; }
@@ -45,10 +61,15 @@ class ImuBuffer {
 
   const std::deque<ImuSample>& samples() const { return samples_; }
   size_t duplicates() const { return duplicates_; }
+  size_t rejected() const { return rejected_; }
 
  private:
+  InputCheckOptions checks_;
   std::deque<ImuSample> samples_;
   size_t duplicates_ = 0;
+  size_t rejected_ = 0;
+  Rejections pending_;
+  ConstantImuDetector constant_;
   int64_t origin_ns_ = 0;
 };
 

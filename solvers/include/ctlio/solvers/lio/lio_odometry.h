@@ -3,14 +3,16 @@
 // sliding window, the scan registration, and the estimator of config.method (GP knots or
 // navigation states), which only adds states and factors. Per scan (AddScan):
 //
-//   prepare scan → [first scan: initialise gravity and the first state] → marginalise the
-//   oldest state → add the new state with its motion/IMU factors → register the keypoints →
-//   check the estimate → update the map → report
+//   drop points timed outside the scan's interval → prepare scan → [first scan: initialise
+//   gravity and the first state] → marginalise the oldest state → add the new state with its
+//   motion/IMU factors → register the keypoints → check the estimate → update the map → check
+//   the IMU against the lidar's motion → report
 //
 // Use: feed the IMU samples in time order with AddImu, and each scan with AddScan once the IMU
 // covers its end. Every scan returns a ScanResult whose status says whether the estimate is
 // trustworthy (kOk), or why not — the odometry never returns a silent garbage pose: degenerate
-// scans, IMU gaps and initialisation failures are flagged with a message.
+// scans, IMU gaps, initialisation failures and implausible input are flagged with a message.
+// The input gates (input_checks.h, thresholds in config.input) apply to every caller.
 #pragma once
 
 #include <memory>
@@ -34,17 +36,20 @@ class LioOdometry {
   LioOdometry(const LioOdometry&) = delete;
   LioOdometry& operator=(const LioOdometry&) = delete;
 
-  // Throws std::invalid_argument if the sample is not finite or older than the previous one
-  // (a duplicate timestamp is dropped and counted in duplicate_imu_samples()).
-  void AddImu(const ImuSample& sample) { imu_.AddImu(sample); }
+  // Throws std::invalid_argument if the sample is older than the previous one (a duplicate
+  // timestamp is dropped and counted in duplicate_imu_samples()). A sample that cannot be
+  // physical (not finite, beyond config.input.max_gyro / max_accel) is rejected and counted in the
+  // next ScanResult (imu_rejected, message); returns false then.
+  bool AddImu(const ImuSample& sample) { return imu_.AddImu(sample); }
   // Processes one scan. Throws std::invalid_argument for a scan out of order or with mismatched
   // point/time arrays; everything else (too few points, IMU gaps, failed initialisation,
-  // divergence) is reported in the result's status.
+  // divergence, points outside the scan's interval, a frozen IMU) is reported in the result.
   ScanResult AddScan(const LidarScan& scan);
 
   const OdometryConfig& config() const { return config_; }
   const std::vector<ScanResult>& results() const { return results_; }
   size_t duplicate_imu_samples() const { return imu_.duplicates(); }
+  size_t rejected_imu_samples() const { return imu_.rejected(); }
   bool initialised() const { return initialised_; }
   // Gravity-aligned frame i → map frame m (valid once initialised()).
   const Mat3& C_mi() const { return C_mi_; }
@@ -61,7 +66,14 @@ class LioOdometry {
 
  private:
   void CheckScan(const LidarScan& scan) const;
-  // Robot-frame points (extrinsic), range gate, voxel subsampling, keypoints, time order.
+  // Input gate: the points timed outside [interval start − tolerance, end + tolerance]
+  // (config.input.scan_time_tolerance; the interval starts at the previous scan's end once
+  // initialised) are dropped into *trimmed, which is returned with *note saying so; `scan` itself
+  // when none is.
+  const LidarScan& DropPointsOutsideInterval(const LidarScan& scan, LidarScan* trimmed,
+                                             std::string* note) const;
+  // Robot-frame points (extrinsic), range gate, voxel subsampling, keypoints, time order. Times
+  // within the tolerance outside the interval (driver clock jitter) are clamped onto it.
   PreparedScan PrepareScan(const LidarScan& scan);
   // First scan: gravity initialisation (with an IMU), the first state, the map.
   void Initialise(const PreparedScan& scan, ScanResult* result);
@@ -80,6 +92,10 @@ class LioOdometry {
                          ScanResult* result);
   // lidar_only with a degenerate direction: the scan is `degenerate` (remapped or not).
   void ReportDegenerateDirections(ScanResult* result) const;
+  // Input gate: an IMU whose output stayed bit-identical for config.input.constant_imu_duration
+  // while the estimate moved since the previous estimated scan makes the scan kSuspect. Here,
+  // not in ImuBuffer: only the odometry knows whether the lidar moved.
+  void CheckFrozenImu(ScanResult* result);
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
 
   OdometryConfig config_;
@@ -91,6 +107,8 @@ class LioOdometry {
 
   Mat3 C_mi_ = Mat3::Identity();
   int64_t last_scan_end_ns_ = 0;
+  SE3 last_pose_;  // T_mr of the newest scan not failed (CheckFrozenImu)
+  bool have_last_pose_ = false;
   bool have_origin_ = false;
   bool initialised_ = false;
   std::vector<ScanResult> results_;

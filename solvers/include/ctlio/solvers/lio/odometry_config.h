@@ -18,6 +18,7 @@
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/manifolds/types.h"
 #include "ctlio/solvers/lio/degeneracy.h"
+#include "ctlio/solvers/lio/input_check_options.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
 
 namespace YAML {
@@ -99,6 +100,9 @@ struct OdometryConfig {
   // --- Sensor setup.
   SE3 T_imu_lidar;  // lidar → robot (IMU) frame
 
+  // --- Plausibility gates on the input (input_checks.h), applied by LioOdometry; YAML `input:`.
+  InputCheckOptions input;
+
   // --- Per-method overrides (YAML key `per_method`): the complete configuration to use when
   // running that method, i.e. this one with the override's keys replaced. One file can so
   // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side.
@@ -110,11 +114,11 @@ struct OdometryConfig {
 };
 
 // Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
-// `lidar_frontend`, `degeneracy` and `per_method`. Missing keys keep their defaults; unknown keys
-// and bad values throw std::runtime_error naming file and line. `per_method` maps a method name
-// (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`, `window`,
+// `lidar_frontend`, `degeneracy`, `input` and `per_method`. Missing keys keep their defaults;
+// unknown keys and bad values throw std::runtime_error naming file and line. `per_method` maps a
+// method name (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`, `window`,
 // `lidar_frontend` whose keys replace the base values for that method only (same keys, same
-// checks; `method` and `extrinsic` cannot be set per method):
+// checks; `method`, `extrinsic` and `input` — properties of the data — cannot be set per method):
 //   lidar_frontend: {max_iterations: 3}
 //   per_method:
 //     imu_input: {lidar_frontend: {max_iterations: 5}}
@@ -133,7 +137,9 @@ struct LidarScan {
 };
 
 // --- Pipeline output, one per scan.
-enum class ScanStatus { kOk, kInitialising, kDegenerate, kImuGap, kFailed };
+// kSuspect: estimated, but from input that cannot be right (the IMU output stayed bit-identical
+// while the lidar moved: a frozen or dead IMU, input_checks.h); not to be trusted.
+enum class ScanStatus { kOk, kInitialising, kDegenerate, kImuGap, kFailed, kSuspect };
 const char* ScanStatusName(ScanStatus status);
 
 struct ScanResult {
@@ -142,7 +148,11 @@ struct ScanResult {
   Vec6 velocity = Vec6::Zero();  // [v; ω] body frame (Singer: −ϖ; baseline: C_rmᵀ v_m)
   Vec6 bias = Vec6::Zero();      // [b_a; b_g]
   ScanStatus status = ScanStatus::kOk;
-  std::string message;  // why, for anything but kOk
+  std::string message;  // why, for anything but kOk; also the input gates' notes (below)
+  // Input gates (input_checks.h): IMU samples rejected since the previous scan (beyond the
+  // physical range or not finite), points dropped for a time outside the scan's interval.
+  int imu_rejected = 0;
+  int points_dropped = 0;
   int keypoints = 0;
   int associations = 0;  // lidar residuals in the final round
   int imu_residuals = 0;
