@@ -11,22 +11,34 @@ void ImuBuffer::AddImu(const ImuSample& s) {
     throw std::invalid_argument(
         "LioOdometry::AddImu: non-finite IMU sample at t = " + std::to_string(s.t_ns) + " ns");
   }
-  if (!samples_.empty()) {
-    if (s.t_ns == samples_.back().t_ns) {
+  if (s.imu < 0 || s.imu >= kMaxImus) {
+    throw std::invalid_argument("LioOdometry::AddImu: IMU index " + std::to_string(s.imu) +
+                                " outside [0, " + std::to_string(kMaxImus) + ")");
+  }
+  if (s.imu >= num_imus()) streams_.resize(s.imu + 1);
+  std::deque<ImuSample>& stream = streams_[s.imu];
+  if (!stream.empty()) {
+    if (s.t_ns == stream.back().t_ns) {
       ++duplicates_;  // documented recovery: keep the first of two equal stamps
       return;
     }
-    if (s.t_ns < samples_.back().t_ns) {
+    if (s.t_ns < stream.back().t_ns) {
       throw std::invalid_argument("LioOdometry::AddImu: IMU time goes backwards (" +
                                   std::to_string(s.t_ns) + " ns after " +
-                                  std::to_string(samples_.back().t_ns) + " ns)");
+                                  std::to_string(stream.back().t_ns) + " ns)");
     }
   }
-  samples_.push_back(s);
+  stream.push_back(s);
 }
 
-std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap) const {
-  const std::deque<ImuSample>& imu = samples_;
+const std::deque<ImuSample>& ImuBuffer::samples(int imu) const {
+  static const std::deque<ImuSample> kNone;
+  return imu >= 0 && imu < num_imus() ? streams_[imu] : kNone;
+}
+
+std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap,
+                                            int imu_index) const {
+  const std::deque<ImuSample>& imu = samples(imu_index);
   std::vector<ImuSegment> out;
   double gap = 0.0;
   if (imu.empty() || t_b <= t_a) {
@@ -66,15 +78,15 @@ std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_
   return out;
 }
 
-double ImuBuffer::MaxGap(double t_a, double t_b) const {
+double ImuBuffer::MaxGap(double t_a, double t_b, int imu) const {
   double gap = 0.0;
-  Segments(t_a, t_b, &gap);
+  Segments(t_a, t_b, &gap, imu);
   return gap;
 }
 
-std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b) const {
+std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b, int imu) const {
   std::vector<ImuSample> out;
-  for (const ImuSample& s : samples_) {
+  for (const ImuSample& s : samples(imu)) {
     const double t = Seconds(s.t_ns);
     if (t > t_a && t <= t_b) out.push_back(s);
   }
@@ -82,7 +94,9 @@ std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b) const {
 }
 
 void ImuBuffer::Trim(double t) {
-  while (samples_.size() > 1 && Seconds(samples_[1].t_ns) <= t) samples_.pop_front();
+  for (std::deque<ImuSample>& samples : streams_) {
+    while (samples.size() > 1 && Seconds(samples[1].t_ns) <= t) samples.pop_front();
+  }
 }
 
 }  // namespace ctlio::lio
