@@ -15,6 +15,11 @@
 // IMU dropout: --imu_outage 0.2,0.5,1,2 adds one scenario per length, an outage of that length
 // centred on the sequence midpoint (the "none" scenario is kept unless --nominal=false).
 //
+// Several IMUs: --imus SPEC adds IMUs 1, 2, ... to every sequence (apps/sim imu_specs.h; the
+// outages of --imu_outage apply to IMU 0). --pose_covariance also computes every scan's pose
+// covariance and writes the NEES per run into OUT/nees.csv and a consistency table into
+// OUT/table.md.
+//
 // Split jobs: each job writes OUT/results.csv (one line per run) and OUT/settings.txt; run
 // subsets (--regimes, --methods, --first_sequence, --sequences) as separate jobs and pool them:
 //   ctlio_experiment --merge DIR1,DIR2,... --out DIR
@@ -28,6 +33,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -38,6 +44,7 @@
 
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
+#include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -67,6 +74,11 @@ DEFINE_string(imu_outage, "",
               "Comma-separated IMU outage lengths [s]: one scenario per length, the outage "
               "centred on the sequence midpoint");
 DEFINE_bool(nominal, true, "With --imu_outage: also run the scenario without outage");
+DEFINE_string(imus, "",
+              "Further IMUs in every sequence: ';'-separated key=value lists (rate, xyz, rpy, "
+              "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage; imu_specs.h)");
+DEFINE_bool(pose_covariance, false,
+            "Pose covariance per scan and its NEES against the truth (OUT/nees.csv)");
 DEFINE_string(merge, "",
               "Comma-separated output folders of earlier jobs: pool their results.csv into the "
               "table of --out instead of running");
@@ -166,6 +178,8 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
     << "\nimu_model " << (shared.imu.body_centric ? "body-centric" : "exact-specific-force")
     << "\nconfig " << std::filesystem::path(config_path).filename().string() << "\nfailure_ate_m "
     << FLAGS_failure_ate << "\n";
+  // Only when set, so that single-IMU settings (and merges with earlier jobs) stay as they were.
+  if (!FLAGS_imus.empty()) s << "imus " << FLAGS_imus << "\n";
   return s.str();
 }
 
@@ -230,6 +244,67 @@ void WriteTable(const std::string& out, const std::string& settings,
       methods.push_back(c.method);
   }
   WriteBarSvg(out + "/table2.svg", bars, regimes, methods);
+}
+
+// OUT/nees.csv (one line per run: mean NEES of the pose, its translation and rotation, the
+// scans, and the error of every IMU's final bias estimate against the true initial bias) and
+// OUT/nees.md (means per regime, method and scenario over the runs' scans; 6 resp. 3 if
+// consistent).
+void WriteNees(const std::string& out, const std::vector<Job>& jobs) {
+  std::ofstream f = io::OpenForWriting(out + "/nees.csv");
+  f << "regime,sequence,method,scenario,scans,nees_pose,nees_translation,nees_rotation,"
+       "bias_error_accel,bias_error_gyro\n"
+    << std::setprecision(10);
+  struct Sum {
+    double pose = 0, translation = 0, rotation = 0;
+    size_t scans = 0;
+    int runs = 0;
+  };
+  std::vector<std::pair<std::string, Sum>> cells;
+  for (const Job& j : jobs) {
+    if (!j.done) continue;
+    // Bias error: RMS over the IMUs of |b̂ − b| (accelerometer, gyro) at the last scan.
+    double ea = NAN, eg = NAN;
+    if (!j.run.final_biases.empty()) {
+      ea = eg = 0.0;
+      size_t n = 0;
+      for (size_t k = 0; k < j.run.final_biases.size() && k < j.run.true_biases.size(); ++k) {
+        if (!j.run.true_biases[k]) continue;
+        const Vec6 d = j.run.final_biases[k] - *j.run.true_biases[k];
+        ea += d.head<3>().squaredNorm();
+        eg += d.tail<3>().squaredNorm();
+        ++n;
+      }
+      ea = n ? std::sqrt(ea / double(n)) : NAN;
+      eg = n ? std::sqrt(eg / double(n)) : NAN;
+    }
+    f << j.regime << ',' << j.index << ',' << j.method << ',' << j.scenario << ','
+      << j.run.nees.size() << ',' << lioapp::Mean(j.run.nees) << ','
+      << lioapp::Mean(j.run.nees_translation) << ',' << lioapp::Mean(j.run.nees_rotation) << ','
+      << ea << ',' << eg << '\n';
+    const std::string key = j.regime + " | " + j.method + " | " + j.scenario;
+    auto it =
+        std::find_if(cells.begin(), cells.end(), [&](const auto& c) { return c.first == key; });
+    if (it == cells.end()) it = cells.insert(cells.end(), {key, Sum{}});
+    for (size_t k = 0; k < j.run.nees.size(); ++k) {
+      it->second.pose += j.run.nees[k];
+      it->second.translation += j.run.nees_translation[k];
+      it->second.rotation += j.run.nees_rotation[k];
+    }
+    it->second.scans += j.run.nees.size();
+    ++it->second.runs;
+  }
+  io::CloseChecked(f, out + "/nees.csv");
+  std::ostringstream md;
+  md << "| regime | method | scenario | runs | scans | NEES pose (6) | translation (3) | rotation "
+        "(3) |\n|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [key, c] : cells) {
+    const double n = std::max<double>(1.0, double(c.scans));
+    md << "| " << key << " | " << c.runs << " | " << c.scans << " | " << c.pose / n << " | "
+       << c.translation / n << " | " << c.rotation / n << " |\n";
+  }
+  io::WriteTextFile(out + "/nees.md", md.str());
+  std::printf("\nConsistency (mean NEES over all scans of the runs):\n%s", md.str().c_str());
 }
 
 // --merge: pool the results of earlier jobs with equal settings.
@@ -356,8 +431,10 @@ int main(int argc, char** argv) {
           if (job.outage_s > 0) {
             c.imu.outages.push_back({0.5 * (c.duration_s - job.outage_s), job.outage_s});
           }
+          c.extra_imus = sim::ParseImuSpecs(FLAGS_imus, c.imu);
           sim::SimulatedSource source(c, "sim:" + job.regime + "/" + std::to_string(job.index));
-          const lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(job.method));
+          lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(job.method));
+          if (FLAGS_pose_covariance) config.pose_covariance = true;
           job.run = lioapp::RunOdometry(source, config, {}, FLAGS_failure_ate);
           job.done = true;
         } catch (const std::exception& e) {
@@ -410,6 +487,7 @@ int main(int argc, char** argv) {
         SettingsText(config_path, sim::PresetName(preset), world_name, shared);
     io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
     lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
+    if (FLAGS_pose_covariance) WriteNees(FLAGS_out, jobs);
     const double el =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::ostringstream provenance;

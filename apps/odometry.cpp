@@ -7,6 +7,7 @@
 //    start|end])
 //   ctlio_odometry --format sim --sim_regime fast --sim_index 0 [--sim_duration 5 ...] ...
 //   ctlio_odometry --format sim --sim_imu_dropout 5:1 ...   # no IMU samples in [5 s, 6 s)
+//   ctlio_odometry --format sim --sim_imus "rate=400,xyz=0.3:0:0,offset=0.0013" ...  # a 2nd IMU
 //   ctlio_odometry --format sim --sim_preset newer_college --sim_index 0 \
 //                  --config data/newer_college_lio.yaml --out DIR
 //
@@ -45,6 +46,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -89,6 +91,13 @@ DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
 DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
 DEFINE_int32(sim_beams, 128, "--format sim: lidar beams");
+DEFINE_string(sim_imus, "",
+              "--format sim: further IMUs, ';'-separated key=value lists (rate, xyz, rpy, offset, "
+              "accel_noise, gyro_noise, accel_bias, gyro_bias, outage; apps/sim imu_specs.h), e.g. "
+              "rate=400,xyz=0.3:0:0,offset=0.0013,accel_noise=0.04,gyro_noise=0.02");
+DEFINE_bool(pose_covariance, false,
+            "Covariance of every scan's pose (window.pose_covariance) and, with ground truth, its "
+            "NEES in evaluation.txt");
 DEFINE_string(sim_imu_dropout, "",
               "--format sim: IMU outages start:length[,start:length...] in seconds since the "
               "sequence start (samples inside are absent), e.g. 5:1");
@@ -115,6 +124,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     given.beams = Given("sim_beams", FLAGS_sim_beams);
     sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
+    c.extra_imus = sim::ParseImuSpecs(FLAGS_sim_imus, c.imu);
     const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
     std::ostringstream name;
     name << "sim:"
@@ -212,6 +222,7 @@ int main(int argc, char** argv) {
     for (const std::string& m : methods) {
       lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
       if (gap_flag) config.input.max_imu_gap_error = FLAGS_max_imu_gap_error;
+      if (FLAGS_pose_covariance) config.pose_covariance = true;
       config.Validate();
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
@@ -253,6 +264,21 @@ int main(int argc, char** argv) {
          << run.constant_imu_scans << "\n";
       if (!run.first_input_warning.empty()) {
         ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
+      }
+      if (!run.imu_note.empty()) ev << "imus \"" << run.imu_note << "\"\n";
+      for (size_t j = 0; j < run.final_biases.size() && run.true_biases.size() > 1; ++j) {
+        ev << "imu" << j << "_bias_estimate";
+        for (int k = 0; k < 6; ++k) ev << ' ' << run.final_biases[j][k];
+        if (j < run.true_biases.size() && run.true_biases[j]) {
+          ev << "\nimu" << j << "_bias_true";
+          for (int k = 0; k < 6; ++k) ev << ' ' << (*run.true_biases[j])[k];
+        }
+        ev << "\n";
+      }
+      if (!run.nees.empty()) {
+        ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
+           << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "
+           << lioapp::Mean(run.nees_rotation) << "\nnees_scans " << run.nees.size() << "\n";
       }
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "

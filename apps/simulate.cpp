@@ -28,6 +28,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 
@@ -50,6 +51,10 @@ DEFINE_string(gyro_scale, "0,0,0", "Gyro scale-factor errors s (x,y,z): (1+s)·�
 DEFINE_double(accel_limit, 0.0, "Accelerometer saturation per axis [m/s²]; 0 = none");
 DEFINE_double(gyro_limit, 0.0, "Gyro saturation per axis [rad/s]; 0 = none");
 DEFINE_string(imu_dropout, "", "IMU outages start:length in seconds, e.g. 5.0:0.5,12:2");
+DEFINE_string(imus, "",
+              "Further IMUs (IMU 1, 2, ...), ';'-separated key=value lists: rate, xyz, rpy, "
+              "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage (apps/sim "
+              "imu_specs.h), e.g. rate=400,xyz=0.3:0:0,offset=0.0013");
 DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second (Poisson); 0 = none");
 DEFINE_double(imu_outage_min, 0.1, "Shortest random IMU outage [s]");
 DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
@@ -153,6 +158,7 @@ int main(int argc, char** argv) {
     I.outage_rate = FLAGS_imu_outage_rate;
     I.outage_length_min = FLAGS_imu_outage_min;
     I.outage_length_max = FLAGS_imu_outage_max;
+    config.extra_imus = sim::ParseImuSpecs(FLAGS_imus, I);
     // The Newer College layout carries no extrinsic and is read with the published one.
     if (FLAGS_layout == "newer_college") config.imu_from_lidar = io::NewerCollegeImuFromLidar();
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
@@ -193,7 +199,8 @@ int main(int argc, char** argv) {
          << FLAGS_accel_scale << "], gyro_scale: [" << FLAGS_gyro_scale
          << "], accel_limit: " << FLAGS_accel_limit << ", gyro_limit: " << FLAGS_gyro_limit
          << ", imu_outage_rate: " << FLAGS_imu_outage_rate << ", imu_outage_length: ["
-         << FLAGS_imu_outage_min << ", " << FLAGS_imu_outage_max << "], axes: [";
+         << FLAGS_imu_outage_min << ", " << FLAGS_imu_outage_max << "], imus: \"" << FLAGS_imus
+         << "\", axes: [";
     for (int j = 0; j < 6; ++j) {
       yaml << (j ? ", " : "") << "[" << config.motion.axes[j].amplitude << ", "
            << config.motion.axes[j].frequency << "]";

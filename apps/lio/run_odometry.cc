@@ -111,9 +111,89 @@ std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
   return eval::ComputeRpeDistance(est, ref, std::min(kDriftWindow, 0.5 * path)).translation_percent;
 }
 
+void ImusFromSource(const io::DataSource& source, lio::OdometryConfig* config) {
+  const std::vector<io::ImuInfo> imus = source.Imus();
+  if (!config->imus.empty() || imus.empty()) return;
+  if (imus.size() == 1 && imus[0].T_body_imu.Matrix().isIdentity(0.0)) return;
+  for (const io::ImuInfo& info : imus) {
+    lio::OdometryConfig::ImuSensor sensor;
+    sensor.T_robot_imu = info.T_body_imu;
+    const auto ratio2 = [](double s, double s0) {
+      return s > 0 && s0 > 0 ? s * s / (s0 * s0) : 1.0;
+    };
+    sensor.accel_variance = config->accel_variance * ratio2(info.accel_sigma, imus[0].accel_sigma);
+    sensor.gyro_variance = config->gyro_variance * ratio2(info.gyro_sigma, imus[0].gyro_sigma);
+    config->imus.push_back(sensor);
+  }
+}
+
+double Mean(const std::vector<double>& v) {
+  if (v.empty()) return NAN;
+  double sum = 0.0;
+  for (const double x : v) sum += x;
+  return sum / double(v.size());
+}
+
+namespace {
+
+// The truth pose at exactly (within 1 ms) t, if there is one.
+std::optional<SE3> TruthPoseAt(const std::vector<io::StampedPose>& truth, int64_t t) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                                   [](const io::StampedPose& q, int64_t x) { return q.t_ns < x; });
+  if (it != truth.end() && std::llabs(it->t_ns - t) <= 1000000) return it->pose;
+  if (it != truth.begin() && std::llabs((it - 1)->t_ns - t) <= 1000000) return (it - 1)->pose;
+  return std::nullopt;
+}
+
+// NEES of the scans' pose covariances against the truth T_world_lidar, the map frame anchored
+// at the first estimated scan (where the estimate is the identity, held constant).
+void PoseNees(const std::vector<lio::ScanResult>& scans, const std::vector<io::StampedPose>& truth,
+              const SE3& T_imu_lidar, RunSummary* run) {
+  std::optional<SE3> T_wm;
+  const SE3 T_lidar_imu = T_imu_lidar.Inverse();
+  for (const lio::ScanResult& r : scans) {
+    if (r.status == lio::ScanStatus::kFailed) continue;
+    const std::optional<SE3> T_wl = TruthPoseAt(truth, r.t_ns);
+    if (!T_wl) continue;
+    if (!T_wm) {  // the first estimate: T_mr = T_mr(first)
+      T_wm = *T_wl * T_lidar_imu * r.T_mr.Inverse();
+      continue;
+    }
+    if (!r.has_pose_covariance) continue;
+    const SE3 T_mr_true = T_wm->Inverse() * *T_wl * T_lidar_imu;
+    const Vec6 e = (T_mr_true * r.T_mr.Inverse()).Log();
+    const Mat6& S = r.pose_covariance;
+    run->nees.push_back(e.dot(S.ldlt().solve(e)));
+    run->nees_translation.push_back(
+        e.head<3>().dot(S.topLeftCorner<3, 3>().ldlt().solve(Vec3(e.head<3>()))));
+    run->nees_rotation.push_back(
+        e.tail<3>().dot(S.bottomRightCorner<3, 3>().ldlt().solve(Vec3(e.tail<3>()))));
+  }
+}
+
+}  // namespace
+
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options, double failure_ate) {
   RunSummary run;
+  ImusFromSource(source, &config);
+  const int num_imus = config.num_imus();
+  if (num_imus > 1) {
+    std::ostringstream note;
+    if (config.method == lio::LioMethod::kImuInput) {
+      note << "imu_input preintegrates one IMU, IMU " << config.input_imu << " (imu.input_imu), of "
+           << num_imus << "; the others are not used (IMU-as-input fuses one IMU: a second one "
+           << "would need its own preintegration and, at a lever arm, the derivative of the gyro)";
+    } else if (config.method == lio::LioMethod::kLidarOnly) {
+      note << "lidar_only uses none of the " << num_imus << " IMUs";
+    } else {
+      note << lio::LioMethodName(config.method) << " takes every sample of all " << num_imus
+           << " IMUs as measurements, each IMU with its mounting and its own biases";
+    }
+    run.imu_note = note.str();
+    LOG(WARNING) << source.Name() << ": " << lio::LioMethodName(config.method) << ": "
+                 << run.imu_note;
+  }
   if (options.extrinsic_from_config) {
     run.extrinsic_origin = "the config (extrinsic:)";
   } else {
@@ -189,6 +269,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     if (r.degeneracy.num_degenerate() > 0) ++run.degenerate_direction_scans;
     if (r.status != lio::ScanStatus::kFailed) {
+      if (!r.imu_biases.empty()) run.final_biases = r.imu_biases;
       run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
       if (options.trajectory_rate_hz > 0.0) {
         auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
@@ -229,7 +310,9 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     const AteResult ate = EvaluateAte(run.trajectory, *truth);
     if (ate.pairs >= 3) run.ate = ate;
     run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
+    if (config.pose_covariance) PoseNees(run.scans, *truth, T_imu_lidar, &run);
   }
+  for (const io::ImuInfo& info : source.Imus()) run.true_biases.push_back(info.true_bias);
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
   return run;

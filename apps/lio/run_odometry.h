@@ -68,6 +68,17 @@ struct RunSummary {
   // ground-truth path (half the path when shorter), per 100 m (ctlio::eval RPE over distance,
   // translation_percent); alignment-free. With ground truth and a path of ≥ 1 m.
   std::optional<double> drift_per_100m;
+  // Several IMUs: what the method does with them (empty with one IMU), e.g. the baseline's
+  // limitation to one IMU. Also logged.
+  std::string imu_note;
+  // [b_a; b_g] of every IMU at the last estimated scan (Singer-LIO, lidar_gyro), and the true
+  // initial biases where the source knows them (simulator).
+  std::vector<Vec6> final_biases;
+  std::vector<std::optional<Vec6>> true_biases;
+  // Consistency (config.pose_covariance and ground truth): per estimated scan after the first,
+  // the NEES of the pose, ε = Log(T_mr,true·T_mr⁻¹), εᵀΣ⁻¹ε (6 if consistent), and of its
+  // translation and rotation parts alone (3 each), with T_mr,true anchored at the first scan.
+  std::vector<double> nees, nees_translation, nees_rotation;
   // The run is a failure if a scan failed after initialisation or the ATE exceeds
   // `failure_ate` (the estimate left the room of any sensible error).
   bool failure = false;
@@ -77,6 +88,15 @@ inline constexpr double kDriftWindow = 10.0;  // m
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options = {}, double failure_ate = 1.0);
+
+// The config's IMU list from the source's IMUs when the config gives none (`imus:`) and the
+// source has more than one IMU or an IMU away from the body frame: each IMU's mounting, and its
+// variances scaled from the config's (which describe the first IMU) by the source's stated noise,
+// σ_j²/σ_0² (unscaled where the source states none).
+void ImusFromSource(const io::DataSource& source, lio::OdometryConfig* config);
+
+// Mean of `v` (NaN if empty).
+double Mean(const std::vector<double>& v);
 
 // ATE of `estimate` against `truth` (time association within 1 ms; truth interpolated between
 // its two nearest poses), SE(3) Umeyama alignment.

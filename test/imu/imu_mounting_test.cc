@@ -176,5 +176,42 @@ TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {
   }
 }
 
+// The mountings of the multi-IMU pipeline at their singular points: the IMU rotation near π about
+// a generic axis and near identity (1e-8 rad), a 0.3 m lever arm, the Singer prior with α·Δt → 0
+// (α = 1e-6 over 0.1 s) and the interpolation time at a knot (s → 0).
+TEST(ImuMounting, JacobiansMatchNumericAtSingularMountings) {
+  std::mt19937 rng(15);
+  PoseManifold pose;
+  RotationManifold rotation;
+  const std::vector<const ceres::Manifold*> gyro_manifolds = {&pose,   nullptr, nullptr, &pose,
+                                                              nullptr, nullptr, nullptr, nullptr};
+  std::vector<const ceres::Manifold*> accel_manifolds = gyro_manifolds;
+  accel_manifolds.push_back(&rotation);
+  const Mat3 cov = 1e-3 * Mat3::Identity();
+  const Vec3 axis = Vec3(0.4, -0.7, 0.59).normalized();
+  const SingerModel<6> tiny_alpha(Vec6::Constant(100.0), Vec6::Constant(1e-6));
+  const Vec3 lever(0.3, 0.0, 0.0);
+  for (const double angle : {M_PI - 1e-6, 1e-8}) {
+    ImuMounting mounting;
+    mounting.C_ri = so3::Exp(angle * axis);
+    mounting.lever_arm = lever;
+    for (int trial = 0; trial < 6; ++trial) {
+      const Blocks blocks = testing::JacobianCheckBlocks(rng, trial);
+      const double t_k = 0.3, t_k1 = 0.4;
+      const double tau = trial == 0 ? t_k + 1e-9 : 0.3 + 0.1 * (trial + 0.5) / 6.0;
+      const Vec3 meas = testing::RandomVec6(rng, 5.0).head<3>();
+      for (const SingerModel<6>& model : {Singer(), tiny_alpha}) {
+        const ImuGyroMeasurement gyro(model, t_k, t_k1, tau, meas, cov, mounting);
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, gyro_manifolds, blocks.Gyro(), 1e-6))
+            << "gyro angle " << angle << " trial " << trial;
+        const ImuAccelMeasurement accel(model, t_k, t_k1, tau, meas, cov, 9.81,
+                                        AccelModel::kSpecificForce, mounting);
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, accel_manifolds, blocks.Accel(), 1e-6))
+            << "accel angle " << angle << " trial " << trial;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::imu

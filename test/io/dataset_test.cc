@@ -8,8 +8,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #include "common/expect_error.h"
@@ -17,6 +19,7 @@
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
+#include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 
 namespace ctlio::io {
@@ -62,6 +65,7 @@ void ExpectSameData(DataSource& written, DataSource& truth, double imu_tol) {
     ASSERT_EQ(a[k].imu.size(), b[k].imu.size()) << k;
     for (size_t j = 0; j < a[k].imu.size(); ++j) {
       EXPECT_EQ(a[k].imu[j].t_ns, b[k].imu[j].t_ns);
+      EXPECT_EQ(a[k].imu[j].imu, b[k].imu[j].imu);
       EXPECT_LT((a[k].imu[j].accel - b[k].imu[j].accel).norm(), imu_tol);
       EXPECT_LT((a[k].imu[j].gyro - b[k].imu[j].gyro).norm(), imu_tol);
     }
@@ -102,6 +106,89 @@ TEST(SimFolder, SimulatorWrittenInCtlioLayoutReadsBackEndToEnd) {
   sim::SimulatedSource truth(SmallSim());
   ExpectSameData(*reader, truth, 1e-12);
   EXPECT_TRUE(fs::exists(d / "ground_truth_tum.txt"));
+}
+
+// Two asynchronous IMUs (200 Hz in the body frame + 400 Hz rotated on a lever arm, clock start
+// 1.3 ms later, other noise and biases): version 2 writes one CSV per IMU and their mountings,
+// rates, noise and biases; everything reads back, samples tagged with their IMU.
+TEST(SimFolder, SeveralImusRoundTripInVersion2) {
+  const fs::path d = TempDir("multi_imu");
+  sim::SimConfig c = SmallSim();
+  c.extra_imus = sim::ParseImuSpecs(
+      "rate=400,xyz=0.3:-0.1:0.05,rpy=0:0:90,offset=0.0013,accel_noise=0.04,gyro_noise=0.02,"
+      "accel_bias=-0.1,gyro_bias=0.01:0.02:-0.03",
+      c.imu);
+  sim::SimulatedSource source(c);
+  EXPECT_EQ(WriteSimFolder(source, d.string()), 6u);
+  EXPECT_TRUE(fs::exists(d / "imu.csv"));
+  EXPECT_TRUE(fs::exists(d / "imu1.csv"));
+  SimFolderReader reader(d.string());
+  EXPECT_EQ(reader.version(), 2);
+  const std::vector<ImuInfo> imus = reader.Imus(), truth_imus = source.Imus();
+  ASSERT_EQ(imus.size(), 2u);
+  for (size_t j = 0; j < 2; ++j) {
+    EXPECT_LT((imus[j].T_body_imu.Inverse() * truth_imus[j].T_body_imu).Log().norm(), 1e-12);
+    EXPECT_EQ(imus[j].rate_hz, truth_imus[j].rate_hz);
+    EXPECT_EQ(imus[j].accel_sigma, truth_imus[j].accel_sigma);
+    EXPECT_EQ(imus[j].gyro_sigma, truth_imus[j].gyro_sigma);
+    ASSERT_TRUE(imus[j].true_bias.has_value());
+    EXPECT_EQ(*imus[j].true_bias, *truth_imus[j].true_bias);
+  }
+  EXPECT_NEAR(imus[1].T_body_imu.translation().x(), 0.3, 1e-15);
+  EXPECT_EQ(imus[1].rate_hz, 400.0);
+  // Both IMUs' samples up to the last scan end, interleaved in time: 200 Hz and 400 Hz.
+  sim::SimulatedSource again(c);
+  const int64_t last_end = ReadAll(again).back().end_ns;
+  size_t per_imu[2] = {0, 0};
+  for (const ImuSample& s : reader.imu()) ++per_imu[s.imu];
+  for (size_t j = 0; j < 2; ++j) {
+    const auto& all = source.simulator().Imu(j);
+    EXPECT_EQ(per_imu[j], size_t(std::count_if(all.begin(), all.end(), [&](const ImuSample& s) {
+                return s.t_ns <= last_end;
+              })));
+  }
+  EXPECT_GT(per_imu[1], per_imu[0] * 19 / 10);
+  EXPECT_EQ(source.simulator().Imu(1).front().t_ns - c.start_ns, 1300000);
+  sim::SimulatedSource truth(c);
+  ExpectSameData(reader, truth, 1e-12);
+}
+
+// A version-1 folder (no `imus`: one IMU in imu.csv, the body frame) still reads.
+TEST(SimFolder, Version1FolderStillReads) {
+  const fs::path d = TempDir("version1");
+  sim::SimulatedSource source(SmallSim());
+  WriteSimFolder(source, d.string());
+  const SE3 T = source.ImuFromLidar();
+  const Eigen::Quaterniond q = T.quaternion();
+  std::ofstream meta(d / "ctlio_sim.yaml");
+  meta << std::setprecision(17) << "format: ctlio_sim\nversion: 1\ngravity: 9.81\n"
+       << "imu_from_lidar: {translation: [" << T.translation().x() << ", " << T.translation().y()
+       << ", " << T.translation().z() << "], quaternion_xyzw: [" << q.x() << ", " << q.y() << ", "
+       << q.z() << ", " << q.w() << "]}\n";
+  meta.close();
+  SimFolderReader reader(d.string());
+  EXPECT_EQ(reader.version(), 1);
+  ASSERT_EQ(reader.Imus().size(), 1u);
+  EXPECT_TRUE(reader.Imus()[0].T_body_imu.Matrix().isIdentity(0.0));
+  sim::SimulatedSource truth(SmallSim());
+  ExpectSameData(reader, truth, 1e-12);
+}
+
+TEST(SimFolder, BadImuListNamesTheFile) {
+  const fs::path d = TempDir("bad_imus");
+  sim::SimulatedSource source(SmallSim());
+  WriteSimFolder(source, d.string());
+  const std::string meta = (d / "ctlio_sim.yaml").string();
+  std::ofstream(meta) << "format: ctlio_sim\nversion: 2\ngravity: 9.81\nimu_from_lidar: "
+                         "{translation: [0, 0, 0], quaternion_xyzw: [0, 0, 0, 1]}\n";
+  ExpectError([&] { SimFolderReader r(d.string()); }, {meta, "imus"});
+  std::ofstream(meta) << "format: ctlio_sim\nversion: 3\ngravity: 9.81\n";
+  ExpectError([&] { SimFolderReader r(d.string()); }, {meta, "version 3"});
+  std::ofstream(meta) << "format: ctlio_sim\nversion: 2\ngravity: 9.81\nimu_from_lidar: "
+                         "{translation: [0, 0, 0], quaternion_xyzw: [0, 0, 0, 1]}\nimus:\n"
+                         "  - {file: imu.csv, body_from_imu: {translation: [0, 0], "
+                         "quaternion_xyzw: [0, 0, 0, 1]}}\n";
+  ExpectError([&] { SimFolderReader r(d.string()); }, {meta, "imus[0].body_from_imu"});
 }
 
 // --- bad inputs -------------------------------------------------------------------------------

@@ -107,6 +107,65 @@ TEST(LidarInertialSim, ExactSpecificForceAndBodyCentricModel) {
   EXPECT_LT((sim.TrueImu(0.1).accel - Vec3(0, 0, c.imu.gravity)).norm(), 1e-12);
 }
 
+// An IMU at T_bi (rotated, on a lever arm p) reads the motion of its own origin: the specific
+// force from the second difference of p_w(t) = T_wb(t)·p, in the IMU frame. The simulator's
+// ω̇×p + ω×(ω×p) are not written here; their size (> 0.1 m/s² in the fast regime) gives the
+// comparison teeth.
+TEST(LidarInertialSim, ImuOnALeverArmReadsTheMotionOfItsOwnOrigin) {
+  SimConfig c = SmallConfig();
+  const LidarInertialSim sim(c);
+  const SE3 T_bi(so3::Exp(Vec3(0.3, -1.2, 2.0)), Vec3(0.3, -0.2, 0.1));
+  const Vec3 g_w(0, 0, -c.imu.gravity);
+  const Mat3 C_ib = T_bi.rotation().transpose();
+  for (double t : {0.4, 0.77, 1.5}) {
+    const double h = 1e-4;
+    const auto origin = [&](double x) { return (sim.WorldFromImu(x) * T_bi).translation(); };
+    const Vec3 a_w = (origin(t + h) - 2 * origin(t) + origin(t - h)) / (h * h);
+    const Mat3 C_wi = sim.WorldFromImu(t).rotation() * T_bi.rotation();
+    const io::ImuSample s = sim.TrueImu(t, T_bi);
+    EXPECT_LT((s.accel - C_wi.transpose() * (a_w - g_w)).norm(), 2e-3) << t;
+    EXPECT_LT((s.gyro - C_ib * sim.BodyTwist(t).tail<3>()).norm(), 1e-14);
+    EXPECT_GT((s.accel - C_ib * sim.TrueImu(t).accel).norm(), 0.1) << t;
+  }
+}
+
+// Further IMUs leave IMU 0 bit-identical (their own noise streams), sample on their own clock
+// grid (rate, start offset), carry their own biases, and are interleaved in time in AllImu().
+TEST(LidarInertialSim, ExtraImusKeepTheFirstAndRunOnTheirOwnClock) {
+  SimConfig c = SmallConfig();
+  const LidarInertialSim one(c);
+  ImuConfig second = c.imu;
+  second.rate_hz = 400.0;
+  second.clock_offset_s = 0.0013;
+  second.body_from_imu = SE3(Mat3::Identity(), Vec3(0.3, 0, 0));
+  second.accel_bias = Vec3::Constant(-0.1);
+  second.outages = {{1.0, 0.5}};
+  c.extra_imus = {second};
+  const LidarInertialSim two(c);
+  ASSERT_EQ(two.NumImus(), 2u);
+  ASSERT_EQ(one.Imu().size(), two.Imu(0).size());
+  for (size_t j = 0; j < one.Imu().size(); ++j) {
+    EXPECT_EQ(one.Imu()[j].t_ns, two.Imu(0)[j].t_ns);
+    EXPECT_EQ(one.Imu()[j].accel, two.Imu(0)[j].accel);
+    EXPECT_EQ(one.Imu()[j].gyro, two.Imu(0)[j].gyro);
+  }
+  const auto& imu1 = two.Imu(1);
+  EXPECT_EQ(imu1.front().t_ns - c.start_ns, 1300000);
+  EXPECT_EQ(imu1[1].t_ns - imu1[0].t_ns, 2500000);
+  for (const io::ImuSample& s : imu1) {
+    EXPECT_EQ(s.imu, 1);
+    const double t = two.Seconds(s.t_ns);
+    EXPECT_FALSE(t >= 1.0 && t < 1.5) << t;  // IMU 1's outage, not IMU 0's
+  }
+  EXPECT_EQ(two.ImuBiases(1).front().head<3>(), Vec3::Constant(-0.1));
+  EXPECT_EQ(two.ImuOutages(1).size(), 1u);
+  EXPECT_TRUE(two.ImuOutages(0).empty());
+  EXPECT_EQ(two.AllImu().size(), two.Imu(0).size() + imu1.size());
+  for (size_t j = 1; j < two.AllImu().size(); ++j) {
+    EXPECT_LE(two.AllImu()[j - 1].t_ns, two.AllImu()[j].t_ns);
+  }
+}
+
 TEST(LidarInertialSim, ImuNoiseAndBiasLevels) {
   SimConfig c = SmallConfig();
   c.duration_s = 20.0;

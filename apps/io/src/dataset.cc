@@ -21,6 +21,37 @@ void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cur
   while (*cursor < imu.size() && imu[*cursor].t_ns <= end_ns) out->push_back(imu[(*cursor)++]);
 }
 
+std::vector<ImuSample> MergeImuStreams(const std::vector<std::vector<ImuSample>>& streams) {
+  std::vector<ImuSample> out;
+  size_t total = 0;
+  for (const auto& s : streams) total += s.size();
+  out.reserve(total);
+  for (size_t j = 0; j < streams.size(); ++j) {
+    for (ImuSample s : streams[j]) {
+      s.imu = int(j);
+      out.push_back(s);
+    }
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const ImuSample& a, const ImuSample& b) { return a.t_ns < b.t_ns; });
+  return out;
+}
+
+void RequireFirstImuInBodyFrame(const DataSource& source, const std::string& target) {
+  const std::vector<ImuInfo> imus = source.Imus();
+  if (imus.empty()) return;
+  if (!imus.front().T_body_imu.Matrix().isIdentity(1e-12)) {
+    throw std::runtime_error(target +
+                             ": this layout holds one IMU in the body frame; the first IMU "
+                             "of " +
+                             source.Name() + " is mounted elsewhere (use the ctlio layout)");
+  }
+  if (imus.size() > 1) {
+    LOG(WARNING) << target << ": this layout holds one IMU; only the first of the " << imus.size()
+                 << " IMUs of " << source.Name() << " is written (the ctlio layout holds all)";
+  }
+}
+
 size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c) {
   if (!c->has_times()) return 0;
   size_t kept = 0;

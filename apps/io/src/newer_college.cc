@@ -192,6 +192,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
                              "published T_imu_lidar; this source has another one (use the ctlio "
                              "layout, or the published extrinsic)");
   }
+  RequireFirstImuInBodyFrame(source, folder + " (Newer College layout)");
   const fs::path seq(folder);
   fs::create_directories(ScanDir(seq));
   fs::create_directories(ImuFile(seq).parent_path());
@@ -201,6 +202,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
   ScanFrame frame;
   while (source.Next(&frame)) {
     for (const ImuSample& s : frame.imu) {
+      if (s.imu != 0) continue;  // the layout holds one IMU: the first (Imus()[0])
       imu << counter++ << ',' << s.t_ns / 1000000000 << ',' << s.t_ns % 1000000000;
       for (int k = 0; k < 3; ++k) imu << ',' << s.gyro[k];
       for (int k = 0; k < 3; ++k) imu << ',' << s.accel[k];

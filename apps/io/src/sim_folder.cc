@@ -68,6 +68,41 @@ void WriteSimScan(const std::string& path, const PointCloud& cloud) {
   CloseChecked(out, path);
 }
 
+namespace {
+
+// A pose mapping {translation, quaternion_xyzw} of ctlio_sim.yaml; `what` names the key.
+SE3 ReadPose(const YAML::Node& node, const std::string& what) {
+  if (!node || !node.IsMap()) throw std::runtime_error(what + ": missing or not a mapping");
+  const auto t = node["translation"].as<std::vector<double>>();
+  const auto q = node["quaternion_xyzw"].as<std::vector<double>>();
+  if (t.size() != 3 || q.size() != 4) throw std::runtime_error(what + ": wrong sizes");
+  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+  const Vec3 r(t[0], t[1], t[2]);
+  // A zero (or non-unit) quaternion is no rotation: Eigen would silently give identity.
+  if (!r.allFinite() || !(std::abs(quat.norm() - 1.0) <= 1e-3)) {
+    throw std::runtime_error(what + ": translation not finite or quaternion norm " +
+                             std::to_string(quat.norm()) + " is not 1");
+  }
+  return SE3(quat.normalized(), r);
+}
+
+void EmitPose(YAML::Emitter& y, const std::string& key, const SE3& T) {
+  const Eigen::Quaterniond q = T.quaternion();
+  y << YAML::Key << key << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "translation" << YAML::Value << YAML::Flow
+    << std::vector<double>{T.translation().x(), T.translation().y(), T.translation().z()};
+  y << YAML::Key << "quaternion_xyzw" << YAML::Value << YAML::Flow
+    << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
+  y << YAML::EndMap;
+}
+
+// The file of IMU j in a version-2 folder: imu.csv (as in version 1), imu1.csv, imu2.csv, ...
+std::string ImuFileName(size_t j) {
+  return j == 0 ? "imu.csv" : "imu" + std::to_string(j) + ".csv";
+}
+
+}  // namespace
+
 SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_error_ns)
     : folder_(folder) {
   const fs::path dir(folder);
@@ -75,26 +110,58 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(folder + ": folder not found");
   const std::string meta_path = (dir / "ctlio_sim.yaml").string();
   if (!fs::is_regular_file(meta_path, ec)) throw std::runtime_error(meta_path + ": file not found");
+  std::vector<std::string> imu_files;
   try {
     const YAML::Node meta = YAML::LoadFile(meta_path);
     if (!meta["format"] || meta["format"].as<std::string>() != "ctlio_sim") {
       throw std::runtime_error("key 'format' is not 'ctlio_sim'");
     }
+    version_ = meta["version"] ? meta["version"].as<int>() : 1;
+    if (version_ < 1 || version_ > 2) {
+      throw std::runtime_error("version " + std::to_string(version_) +
+                               " is not supported (1 or 2)");
+    }
     gravity_ = meta["gravity"].as<double>();
     if (!(gravity_ > 0.0 && gravity_ < 100.0)) {
       throw std::runtime_error("gravity " + std::to_string(gravity_) + " is not in (0, 100) m/s²");
     }
-    const auto t = meta["imu_from_lidar"]["translation"].as<std::vector<double>>();
-    const auto q = meta["imu_from_lidar"]["quaternion_xyzw"].as<std::vector<double>>();
-    if (t.size() != 3 || q.size() != 4) throw std::runtime_error("imu_from_lidar: wrong sizes");
-    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-    const Vec3 r(t[0], t[1], t[2]);
-    // A zero (or non-unit) quaternion is no rotation: Eigen would silently give identity.
-    if (!r.allFinite() || !(std::abs(quat.norm() - 1.0) <= 1e-3)) {
-      throw std::runtime_error("imu_from_lidar: translation not finite or quaternion norm " +
-                               std::to_string(quat.norm()) + " is not 1");
+    imu_from_lidar_ = ReadPose(meta["imu_from_lidar"], "imu_from_lidar");
+    if (version_ == 1) {  // one IMU in imu.csv, the body frame
+      imus_.push_back(ImuInfo{});
+      imu_files.push_back("imu.csv");
+    } else {
+      const YAML::Node list = meta["imus"];
+      if (!list || !list.IsSequence() || list.size() == 0) {
+        throw std::runtime_error("version 2 needs 'imus', a non-empty list");
+      }
+      for (size_t j = 0; j < list.size(); ++j) {
+        const YAML::Node n = list[j];
+        const std::string what = "imus[" + std::to_string(j) + "]";
+        ImuInfo info;
+        info.name = n["name"] ? n["name"].as<std::string>() : "imu" + std::to_string(j);
+        const std::string file = n["file"].as<std::string>();
+        if (file.empty() || fs::path(file).is_absolute() || file.find("..") != std::string::npos) {
+          throw std::runtime_error(what + ".file '" + file + "' must be a path inside the folder");
+        }
+        info.T_body_imu = ReadPose(n["body_from_imu"], what + ".body_from_imu");
+        if (n["rate_hz"]) info.rate_hz = n["rate_hz"].as<double>();
+        if (n["accel_noise"]) info.accel_sigma = n["accel_noise"].as<double>();
+        if (n["gyro_noise"]) info.gyro_sigma = n["gyro_noise"].as<double>();
+        if (!(info.rate_hz >= 0 && info.accel_sigma >= 0 && info.gyro_sigma >= 0)) {
+          throw std::runtime_error(what + ": rate_hz, accel_noise and gyro_noise must be >= 0");
+        }
+        if (n["accel_bias"] && n["gyro_bias"]) {
+          const auto ba = n["accel_bias"].as<std::vector<double>>();
+          const auto bg = n["gyro_bias"].as<std::vector<double>>();
+          if (ba.size() != 3 || bg.size() != 3) throw std::runtime_error(what + ": bias sizes");
+          Vec6 b;
+          b << ba[0], ba[1], ba[2], bg[0], bg[1], bg[2];
+          info.true_bias = b;
+        }
+        imus_.push_back(info);
+        imu_files.push_back(file);
+      }
     }
-    imu_from_lidar_ = SE3(quat.normalized(), r);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(meta_path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   } catch (const std::runtime_error& e) {
@@ -118,19 +185,25 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
   }
   if (scans_.empty()) throw std::runtime_error(scans_path + ": no scans");
 
-  const std::string imu_path = (dir / "imu.csv").string();
-  std::vector<int> lines;
-  for (const auto& row : ReadTable(imu_path, true)) {
-    ExpectFields(imu_path, row, 7);
-    ImuSample s;
-    s.t_ns = ToInt64(imu_path, row, 0);
-    s.gyro = ToVec3(imu_path, row, 1);
-    s.accel = ToVec3(imu_path, row, 4);
-    imu_.push_back(s);
-    lines.push_back(row.line);
+  std::vector<std::vector<ImuSample>> streams;
+  for (const std::string& file : imu_files) {
+    const std::string imu_path = (dir / file).string();
+    std::vector<ImuSample> imu;
+    std::vector<int> lines;
+    for (const auto& row : ReadTable(imu_path, true)) {
+      ExpectFields(imu_path, row, 7);
+      ImuSample s;
+      s.t_ns = ToInt64(imu_path, row, 0);
+      s.gyro = ToVec3(imu_path, row, 1);
+      s.accel = ToVec3(imu_path, row, 4);
+      imu.push_back(s);
+      lines.push_back(row.line);
+    }
+    if (imu.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
+    CheckImuStream(imu_path, lines, max_imu_gap_error_ns, &imu);
+    streams.push_back(std::move(imu));
   }
-  if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
-  CheckImuStream(imu_path, lines, max_imu_gap_error_ns, &imu_);
+  imu_ = MergeImuStreams(streams);
 
   const std::string gt_path = (dir / "ground_truth.csv").string();
   if (fs::is_regular_file(gt_path, ec)) {
@@ -180,35 +253,59 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
                       bool write_ground_truth) {
   const fs::path dir(folder);
   fs::create_directories(dir / "scans");
+  const std::vector<ImuInfo> imus = source.Imus();
+  if (imus.empty()) throw std::runtime_error(source.Name() + ": no IMU to write");
   {
     YAML::Emitter y;
     y << YAML::BeginMap << YAML::Key << "format" << YAML::Value << "ctlio_sim";
-    y << YAML::Key << "version" << YAML::Value << 1;
+    y << YAML::Key << "version" << YAML::Value << 2;
     y << YAML::Key << "source" << YAML::Value << source.Name();
     y << YAML::Key << "gravity" << YAML::Value << source.Gravity().value_or(9.81);
-    const SE3 T = source.ImuFromLidar();
-    const Eigen::Quaterniond q = T.quaternion();
-    y << YAML::Key << "imu_from_lidar" << YAML::Value << YAML::BeginMap;
-    y << YAML::Key << "translation" << YAML::Value << YAML::Flow
-      << std::vector<double>{T.translation().x(), T.translation().y(), T.translation().z()};
-    y << YAML::Key << "quaternion_xyzw" << YAML::Value << YAML::Flow
-      << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
-    y << YAML::EndMap;
+    EmitPose(y, "imu_from_lidar", source.ImuFromLidar());
+    y << YAML::Key << "imus" << YAML::Value << YAML::BeginSeq;
+    for (size_t j = 0; j < imus.size(); ++j) {
+      const ImuInfo& info = imus[j];
+      y << YAML::BeginMap << YAML::Key << "name" << YAML::Value << info.name;
+      y << YAML::Key << "file" << YAML::Value << ImuFileName(j);
+      EmitPose(y, "body_from_imu", info.T_body_imu);
+      y << YAML::Key << "rate_hz" << YAML::Value << info.rate_hz;
+      y << YAML::Key << "accel_noise" << YAML::Value << info.accel_sigma;
+      y << YAML::Key << "gyro_noise" << YAML::Value << info.gyro_sigma;
+      if (info.true_bias) {
+        const Vec6& b = *info.true_bias;
+        y << YAML::Key << "accel_bias" << YAML::Value << YAML::Flow
+          << std::vector<double>{b[0], b[1], b[2]};
+        y << YAML::Key << "gyro_bias" << YAML::Value << YAML::Flow
+          << std::vector<double>{b[3], b[4], b[5]};
+      }
+      y << YAML::EndMap;
+    }
+    y << YAML::EndSeq;
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
     WriteTextFile((dir / "ctlio_sim.yaml").string(),
                   "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" +
                       std::string(y.c_str()) + "\n");
   }
-  const std::string imu_path = (dir / "imu.csv").string(),
-                    scans_path = (dir / "scans.csv").string();
-  std::ofstream imu = OpenForWriting(imu_path), scans = OpenForWriting(scans_path);
-  imu << "t_ns,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
+  const std::string scans_path = (dir / "scans.csv").string();
+  std::vector<std::string> imu_paths;
+  std::vector<std::ofstream> imu_files;
+  for (size_t j = 0; j < imus.size(); ++j) {
+    imu_paths.push_back((dir / ImuFileName(j)).string());
+    imu_files.push_back(OpenForWriting(imu_paths.back()));
+    imu_files.back() << "t_ns,wx,wy,wz,ax,ay,az\n" << std::setprecision(17);
+  }
+  std::ofstream scans = OpenForWriting(scans_path);
   scans << "index,start_ns,end_ns,points,file\n";
   ScanFrame frame;
   size_t n = 0;
   while (source.Next(&frame)) {
     for (const ImuSample& s : frame.imu) {
+      if (s.imu < 0 || size_t(s.imu) >= imus.size()) {
+        throw std::runtime_error(source.Name() + ": IMU sample of IMU " + std::to_string(s.imu) +
+                                 ", the source has " + std::to_string(imus.size()));
+      }
+      std::ofstream& imu = imu_files[size_t(s.imu)];
       imu << s.t_ns;
       for (int k = 0; k < 3; ++k) imu << ',' << s.gyro[k];
       for (int k = 0; k < 3; ++k) imu << ',' << s.accel[k];
@@ -222,7 +319,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     ++n;
     if (progress) progress(n, source.NumScans());
   }
-  CloseChecked(imu, imu_path);
+  for (size_t j = 0; j < imus.size(); ++j) CloseChecked(imu_files[j], imu_paths[j]);
   CloseChecked(scans, scans_path);
   if (const auto gt = write_ground_truth ? source.GroundTruth() : std::nullopt) {
     const std::string gt_path = (dir / "ground_truth.csv").string();

@@ -51,34 +51,19 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   grid_.push_back(guided ? SE3() : config_.world_from_imu0);
   for (size_t i = 1; i < n; ++i) grid_.push_back(MagnusStep(grid_.back(), double(i - 1) * h, h));
 
-  // IMU stream: one generator for noise and bias walk, drawn in sample order.
-  std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xC7u};
-  std::mt19937_64 rng(seq);
-  std::normal_distribution<double> normal;
-  const int64_t dt_ns = PeriodNs(I.rate_hz);
-  const double dt = 1e-9 * double(dt_ns);
-  const int64_t end_ns = config_.start_ns + std::llround(config_.duration_s * 1e9);
-  Vec6 bias;
-  bias << I.accel_bias, I.gyro_bias;
-  for (int64_t t_ns = config_.start_ns; t_ns <= end_ns; t_ns += dt_ns) {
-    io::ImuSample s = TrueImu(Seconds(t_ns));
-    if (!I.accel_scale.isZero()) s.accel = s.accel.cwiseProduct(Vec3::Ones() + I.accel_scale);
-    if (!I.gyro_scale.isZero()) s.gyro = s.gyro.cwiseProduct(Vec3::Ones() + I.gyro_scale);
-    for (int k = 0; k < 3; ++k) {
-      s.accel[k] += bias[k] + I.accel_noise * normal(rng);
-      s.gyro[k] += bias[3 + k] + I.gyro_noise * normal(rng);
-    }
-    if (I.accel_limit > 0) s.accel = s.accel.cwiseMax(-I.accel_limit).cwiseMin(I.accel_limit);
-    if (I.gyro_limit > 0) s.gyro = s.gyro.cwiseMax(-I.gyro_limit).cwiseMin(I.gyro_limit);
-    imu_.push_back(s);
-    biases_.push_back(bias);
-    for (int k = 0; k < 3; ++k) {
-      bias[k] += I.accel_bias_walk * std::sqrt(dt) * normal(rng);
-      bias[3 + k] += I.gyro_bias_walk * std::sqrt(dt) * normal(rng);
+  for (const ImuConfig& J : config_.extra_imus) {
+    if (!(J.rate_hz > 0) || J.clock_offset_s < 0 || J.accel_noise < 0 || J.gyro_noise < 0 ||
+        J.outage_rate < 0) {
+      throw std::runtime_error(
+          "LidarInertialSim: invalid extra IMU (rate > 0, clock offset, noise, outage rate >= 0)");
     }
   }
-
-  ApplyImuOutages();
+  const size_t num_imus = 1 + config_.extra_imus.size();
+  imu_.resize(num_imus);
+  biases_.resize(num_imus);
+  outages_.resize(num_imus);
+  for (size_t j = 0; j < num_imus; ++j) GenerateImu(j);
+  all_imu_ = num_imus == 1 ? imu_[0] : io::MergeImuStreams(imu_);
 
   // Beam and azimuth tables; fixed beam-angle errors from their own stream.
   if (L.elevation_error_deg > 0 || L.azimuth_error_deg > 0) {
@@ -104,6 +89,45 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
     cos_az_.push_back(std::cos(az));
     sin_az_.push_back(std::sin(az));
   }
+}
+
+void LidarInertialSim::GenerateImu(size_t j) {
+  const ImuConfig& I = ImuConfigOf(j);
+  // One generator for noise and bias walk, drawn in sample order; IMU 0 keeps the stream of the
+  // single-IMU simulator, IMU j > 0 gets its own.
+  std::vector<uint32_t> seeds{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xC7u};
+  if (j > 0) seeds.push_back(uint32_t(j));
+  std::seed_seq seq(seeds.begin(), seeds.end());
+  std::mt19937_64 rng(seq);
+  std::normal_distribution<double> normal;
+  const int64_t dt_ns = PeriodNs(I.rate_hz);
+  const double dt = 1e-9 * double(dt_ns);
+  const int64_t end_ns = config_.start_ns + std::llround(config_.duration_s * 1e9);
+  const bool mounted = !I.body_from_imu.Matrix().isIdentity(0.0);
+  std::vector<io::ImuSample>& imu = imu_[j];
+  std::vector<Vec6>& biases = biases_[j];
+  Vec6 bias;
+  bias << I.accel_bias, I.gyro_bias;
+  for (int64_t t_ns = config_.start_ns + std::llround(I.clock_offset_s * 1e9); t_ns <= end_ns;
+       t_ns += dt_ns) {
+    io::ImuSample s = mounted ? TrueImu(Seconds(t_ns), I.body_from_imu) : TrueImu(Seconds(t_ns));
+    s.imu = int(j);
+    if (!I.accel_scale.isZero()) s.accel = s.accel.cwiseProduct(Vec3::Ones() + I.accel_scale);
+    if (!I.gyro_scale.isZero()) s.gyro = s.gyro.cwiseProduct(Vec3::Ones() + I.gyro_scale);
+    for (int k = 0; k < 3; ++k) {
+      s.accel[k] += bias[k] + I.accel_noise * normal(rng);
+      s.gyro[k] += bias[3 + k] + I.gyro_noise * normal(rng);
+    }
+    if (I.accel_limit > 0) s.accel = s.accel.cwiseMax(-I.accel_limit).cwiseMin(I.accel_limit);
+    if (I.gyro_limit > 0) s.gyro = s.gyro.cwiseMax(-I.gyro_limit).cwiseMin(I.gyro_limit);
+    imu.push_back(s);
+    biases.push_back(bias);
+    for (int k = 0; k < 3; ++k) {
+      bias[k] += I.accel_bias_walk * std::sqrt(dt) * normal(rng);
+      bias[3 + k] += I.gyro_bias_walk * std::sqrt(dt) * normal(rng);
+    }
+  }
+  ApplyImuOutages(j);
 }
 
 Vec6 LidarInertialSim::BodyTwist(double t) const {
@@ -171,7 +195,7 @@ SE3 LidarInertialSim::LocalPose(double t) const {
   return MagnusStep(grid_[k], double(k) * h, t - double(k) * h);
 }
 
-io::ImuSample LidarInertialSim::TrueImu(double t) const {
+io::ImuSample LidarInertialSim::TrueImu(double t, const SE3& body_from_imu) const {
   const Vec6 xi = BodyTwist(t);
   const Vec6 dxi = BodyTwistRate(t);
   const Vec3 v = xi.head<3>(), w = xi.tail<3>();
@@ -183,6 +207,14 @@ io::ImuSample LidarInertialSim::TrueImu(double t) const {
   // Specific force f = C_bw(a_w − g_w) with a_w = C_wb(v̇ + ω×v).
   s.accel = dxi.head<3>() - C_wb.transpose() * g_w;
   if (!config_.imu.body_centric) s.accel += w.cross(v);
+  if (!body_from_imu.Matrix().isIdentity(0.0)) {
+    // Rigid-body motion of the IMU's origin at lever arm p: ω̇×p + ω×(ω×p), then into the IMU
+    // frame (imu_mounting.h).
+    const Vec3& p = body_from_imu.translation();
+    const Mat3 C_ib = body_from_imu.rotation().transpose();
+    s.accel = C_ib * (s.accel + dxi.tail<3>().cross(p) + w.cross(w.cross(p)));
+    s.gyro = C_ib * w;
+  }
   return s;
 }
 
@@ -223,33 +255,38 @@ RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d) const {
   return world_.scene.Cast(o, d, reach);
 }
 
-void LidarInertialSim::ApplyImuOutages() {
-  const auto& I = config_.imu;
-  outages_ = I.outages;
+void LidarInertialSim::ApplyImuOutages(size_t j) {
+  const ImuConfig& I = ImuConfigOf(j);
+  std::vector<ImuOutage>& outages = outages_[j];
+  outages = I.outages;
   if (I.outage_rate > 0) {  // Poisson arrivals, uniform lengths, from their own stream
-    std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xD0u};
+    std::vector<uint32_t> seeds{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xD0u};
+    if (j > 0) seeds.push_back(uint32_t(j));
+    std::seed_seq seq(seeds.begin(), seeds.end());
     std::mt19937_64 rng(seq);
     for (double t = 0.0;;) {
       t += -std::log(1.0 - Uniform(rng, 0, 1)) / I.outage_rate;
       if (t >= config_.duration_s) break;
-      outages_.push_back({t, Uniform(rng, I.outage_length_min, I.outage_length_max)});
+      outages.push_back({t, Uniform(rng, I.outage_length_min, I.outage_length_max)});
     }
   }
-  if (outages_.empty()) return;
+  if (outages.empty()) return;
+  std::vector<io::ImuSample>& imu = imu_[j];
+  std::vector<Vec6>& biases = biases_[j];
   std::vector<io::ImuSample> kept;
   std::vector<Vec6> kept_bias;
-  for (size_t j = 0; j < imu_.size(); ++j) {
-    const int64_t t = imu_[j].t_ns - config_.start_ns;
-    const bool out = std::any_of(outages_.begin(), outages_.end(), [t](const ImuOutage& o) {
+  for (size_t i = 0; i < imu.size(); ++i) {
+    const int64_t t = imu[i].t_ns - config_.start_ns;
+    const bool out = std::any_of(outages.begin(), outages.end(), [t](const ImuOutage& o) {
       const int64_t a = std::llround(o.start_s * 1e9), b = a + std::llround(o.length_s * 1e9);
       return t >= a && t < b;
     });
     if (out) continue;
-    kept.push_back(imu_[j]);
-    kept_bias.push_back(biases_[j]);
+    kept.push_back(imu[i]);
+    kept_bias.push_back(biases[i]);
   }
-  imu_.swap(kept);
-  biases_.swap(kept_bias);
+  imu.swap(kept);
+  biases.swap(kept_bias);
 }
 
 io::PointCloud LidarInertialSim::Scan(size_t k) const {
@@ -319,9 +356,27 @@ bool SimulatedSource::Next(io::ScanFrame* frame) {
   const int last = sim_.config().lidar.firings_per_revolution - 1;
   frame->end_ns = sim_.FiringTimeNs(next_, last - last % sim_.config().lidar.firing_decimation);
   frame->imu.clear();
-  io::TakeImuUntil(sim_.Imu(), frame->end_ns, &imu_cursor_, &frame->imu);
+  io::TakeImuUntil(sim_.AllImu(), frame->end_ns, &imu_cursor_, &frame->imu);
   ++next_;
   return true;
+}
+
+std::vector<io::ImuInfo> SimulatedSource::Imus() const {
+  std::vector<io::ImuInfo> out;
+  for (size_t j = 0; j < sim_.NumImus(); ++j) {
+    const ImuConfig& I = sim_.ImuConfigOf(j);
+    io::ImuInfo info;
+    info.name = "imu" + std::to_string(j);
+    info.T_body_imu = I.body_from_imu;
+    info.rate_hz = I.rate_hz;
+    info.accel_sigma = I.accel_noise;
+    info.gyro_sigma = I.gyro_noise;
+    Vec6 b;
+    b << I.accel_bias, I.gyro_bias;
+    info.true_bias = b;
+    out.push_back(info);
+  }
+  return out;
 }
 
 std::optional<std::vector<io::StampedPose>> SimulatedSource::GroundTruth() const {

@@ -15,10 +15,14 @@
 namespace ctlio::lio {
 
 GpKnotEstimator::GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& imu)
-    : config_(config), imu_(imu), model_(config.qc, config.alpha) {}
+    : config_(config), imu_(imu), model_(config.qc, config.alpha) {
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    mountings_.push_back(imu::ImuMounting::FromPose(config_.ImuPose(j)));
+  }
+}
 
 GpKnotEstimator::Knot GpKnotEstimator::AddKnot(double t, const SE3& T_rm, const Vec6& w,
-                                               const Vec6& dw, const Vec6& bias,
+                                               const Vec6& dw, const std::vector<Vec6>& bias,
                                                SlidingWindow* window) {
   Knot k;
   k.t = t;
@@ -26,14 +30,16 @@ GpKnotEstimator::Knot GpKnotEstimator::AddKnot(double t, const SE3& T_rm, const 
   k.pose = window->AddPoseState(k.keys.pose, T_rm);
   k.velocity = window->AddVectorState(k.keys.velocity, w);
   k.acceleration = window->AddVectorState(k.keys.acceleration, dw);
-  if (uses_imu()) k.bias = window->AddVectorState(k.keys.bias, bias);
+  for (int j = 0; j < num_imus(); ++j) {
+    k.bias.push_back(window->AddVectorState(k.keys.Bias(j), bias[j]));
+  }
   return k;
 }
 
 std::vector<StateId> GpKnotEstimator::OldestKeys() const {
   const Knot& k = knots_.front();
   std::vector<StateId> keys = k.keys.Motion();
-  if (k.bias != nullptr) keys.push_back(k.keys.bias);
+  for (size_t j = 0; j < k.bias.size(); ++j) keys.push_back(k.keys.Bias(static_cast<int>(j)));
   return keys;
 }
 
@@ -64,7 +70,9 @@ void GpKnotEstimator::Report(ScanResult* result) const {
   result->T_mr = PoseManifold::Pose(k.pose).Inverse();
   // ϖ is minus the body twist [v; ω] in the robot frame (SPEC §1).
   result->velocity = -Eigen::Map<const Vec6>(k.velocity);
-  result->bias = k.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(k.bias)) : Vec6::Zero();
+  result->bias = k.bias.empty() ? Vec6::Zero() : Vec6(Eigen::Map<const Vec6>(k.bias[0]));
+  result->imu_biases.clear();
+  for (const double* b : k.bias) result->imu_biases.push_back(Eigen::Map<const Vec6>(b));
 }
 
 void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
@@ -76,49 +84,58 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
     window->AddRotationState(kGravityKey, C_mi);
     if (!config_.estimate_gravity) window->SetStateConstant(kGravityKey, true);
   }
-  knots_.push_back(AddKnot(scan.t_end, SE3(), Vec6::Zero(), Vec6::Zero(), Vec6::Zero(), window));
+  knots_.push_back(AddKnot(scan.t_end, SE3(), Vec6::Zero(), Vec6::Zero(),
+                           std::vector<Vec6>(num_imus(), Vec6::Zero()), window));
   const Knot& k = knots_.back();
   for (StateId key : k.keys.Motion()) window->SetStateConstant(key, true);
-  if (uses_imu()) window->AddResidualBlock(MakeInitialBiasPrior(config_), nullptr, {k.keys.bias});
+  for (int j = 0; j < num_imus(); ++j) {
+    window->AddResidualBlock(MakeInitialBiasPrior(config_), nullptr, {k.keys.Bias(j)});
+  }
 }
 
 void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                ScanResult* result) {
   const Knot prev = knots_.back();
   const double dt = scan.t_end - prev.t;
-  const std::vector<ImuSample> imu =
-      uses_imu() ? imu_.Samples(prev.t, scan.t_end) : std::vector<ImuSample>();
+  std::vector<std::vector<ImuSample>> imu(num_imus());
+  for (int j = 0; j < num_imus(); ++j) imu[j] = imu_.Samples(prev.t, scan.t_end, j);
 
-  // Initial guess: constant body velocity from the previous knot; with a gyro, its newest
-  // sample gives the angular part (ϖ_φ = −(ω_meas − b_g), SPEC §1).
+  // Initial guess: constant body velocity from the previous knot; with a gyro, the newest
+  // sample (of the first IMU that has one) gives the angular part (ϖ_φ = −C_ri(ω_meas − b_g),
+  // SPEC §1, imu_mounting.h).
   Vec6 w = Eigen::Map<const Vec6>(prev.velocity);
-  if (uses_imu() && !imu.empty()) {
-    w.tail<3>() = -(imu.back().gyro - Eigen::Map<const Vec3>(prev.bias + 3));
+  for (int j = 0; j < num_imus(); ++j) {
+    if (imu[j].empty()) continue;
+    const Vec3 rate = imu[j].back().gyro - Eigen::Map<const Vec3>(prev.bias[j] + 3);
+    w.tail<3>() = mountings_[j].HasRotation() ? Vec3(-(mountings_[j].C_ri * rate)) : Vec3(-rate);
+    break;
   }
-  const Vec6 bias = prev.bias != nullptr ? Vec6(Eigen::Map<const Vec6>(prev.bias)) : Vec6::Zero();
+  std::vector<Vec6> bias;
+  for (const double* b : prev.bias) bias.push_back(Eigen::Map<const Vec6>(b));
   knots_.push_back(AddKnot(scan.t_end, SE3::Exp(dt * w) * PoseManifold::Pose(prev.pose), w,
                            Vec6::Zero(), bias, window));
   const Knot& k = knots_.back();
 
   // GP prior between the knots (SPEC §2).
   window->AddResidualBlock(new gp::SingerPrior(model_, dt), nullptr, KnotPair(prev.keys, k.keys));
-  if (uses_imu()) {
+  for (int j = 0; j < num_imus(); ++j) {
     window->AddResidualBlock(MakeBiasRandomWalk(config_, dt), nullptr,
-                             {prev.keys.bias, k.keys.bias});
-    AddImuMeasurements(prev, k, imu, window, result);
+                             {prev.keys.Bias(j), k.keys.Bias(j)});
+    AddImuMeasurements(prev, k, j, imu[j], window, result);
   }
 }
 
-void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k,
+void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int imu_index,
                                          const std::vector<ImuSample>& imu, SlidingWindow* window,
                                          ScanResult* result) const {
-  const Mat3 gyro_cov = config_.gyro_variance * Mat3::Identity();
-  const Mat3 accel_cov = config_.accel_variance * Mat3::Identity();
+  const Mat3 gyro_cov = config_.GyroVariance(imu_index) * Mat3::Identity();
+  const Mat3 accel_cov = config_.AccelVariance(imu_index) * Mat3::Identity();
+  const imu::ImuMounting& mounting = mountings_[imu_index];
   const imu::AccelModel accel_model = config_.exact_specific_force ? imu::AccelModel::kSpecificForce
                                                                    : imu::AccelModel::kBodyCentric;
   std::vector<StateId> gyro_states = KnotPair(prev.keys, k.keys);
-  gyro_states.push_back(prev.keys.bias);
-  gyro_states.push_back(k.keys.bias);
+  gyro_states.push_back(prev.keys.Bias(imu_index));
+  gyro_states.push_back(k.keys.Bias(imu_index));
   std::vector<StateId> accel_states = gyro_states;
   accel_states.push_back(kGravityKey);
   // One loss per scan, shared by its accelerometer residuals (the window ref-counts it).
@@ -134,12 +151,12 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k,
     const auto state =
         std::make_shared<gp::SharedStateInterpolation>(model_, prev.t, k.t, tau, knots);
     window->shared_interpolations().Add(state);
-    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov), nullptr,
+    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov, mounting), nullptr,
                              gyro_states);
     ++result->imu_residuals;
     if (config_.method == LioMethod::kSingerLio) {
       window->AddResidualBlock(
-          new imu::ImuAccelMeasurement(state, s.accel, accel_cov, config_.gravity, accel_model),
+          new imu::ImuAccelMeasurement(state, s.accel, accel_cov, config_.gravity, accel_model, mounting),
           accel_loss.get(), accel_states);
       accel_loss_used = accel_loss != nullptr;
       ++result->imu_residuals;

@@ -14,7 +14,10 @@ bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig&
                        std::string* message) {
   const bool uses_accel =
       config.method == LioMethod::kSingerLio || config.method == LioMethod::kImuInput;
-  const std::vector<ImuSample> samples(imu.samples().begin(), imu.samples().end());
+  // From the input IMU (the first unless imu.input_imu names another), at rest: its lever arm
+  // does not matter, its rotation turns its gravity direction into the robot frame's.
+  const std::deque<ImuSample>& stream = imu.samples(config.input_imu);
+  const std::vector<ImuSample> samples(stream.begin(), stream.end());
   if (samples.empty()) {
     *message = "gravity initialisation: no IMU samples before the first scan end";
     return false;
@@ -43,6 +46,8 @@ bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig&
   options.min_samples = 10;
   try {
     *C_mi = imu::InitializeGravity(samples, t0_ns, end_ns - t0_ns + 1, options).C_mi;
+    const Mat3 C_ri = config.ImuPose(config.input_imu).rotation();
+    if (!C_ri.isIdentity(0.0)) *C_mi = C_ri * *C_mi;
   } catch (const std::exception& e) {
     *message = std::string("gravity initialisation failed: ") + e.what();
     return false;

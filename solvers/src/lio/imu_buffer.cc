@@ -9,15 +9,24 @@
 namespace ctlio::lio {
 
 bool ImuBuffer::AddImu(const ImuSample& s) {
-  if (!samples_.empty()) {
-    if (s.t_ns == samples_.back().t_ns) {
+  if (s.imu < 0 || s.imu >= kMaxImus) {
+    throw std::invalid_argument("LioOdometry::AddImu: IMU index " + std::to_string(s.imu) +
+                                " outside [0, " + std::to_string(kMaxImus) + ")");
+  }
+  if (s.imu >= num_imus()) {
+    streams_.resize(s.imu + 1);
+    constant_.resize(s.imu + 1);
+  }
+  std::deque<ImuSample>& stream = streams_[s.imu];
+  if (!stream.empty()) {
+    if (s.t_ns == stream.back().t_ns) {
       ++duplicates_;  // documented recovery: keep the first of two equal stamps
       return true;
     }
-    if (s.t_ns < samples_.back().t_ns) {
+    if (s.t_ns < stream.back().t_ns) {
       throw std::invalid_argument("LioOdometry::AddImu: IMU time goes backwards (" +
                                   std::to_string(s.t_ns) + " ns after " +
-                                  std::to_string(samples_.back().t_ns) + " ns)");
+                                  std::to_string(stream.back().t_ns) + " ns)");
     }
   }
   if (const auto why = CheckImuRange(s, checks_)) {
@@ -31,8 +40,8 @@ bool ImuBuffer::AddImu(const ImuSample& s) {
     }
     return false;
   }
-  constant_.Add(s);
-  samples_.push_back(s);
+  constant_[s.imu].Add(s);
+  stream.push_back(s);
   return true;
 }
 
@@ -42,8 +51,20 @@ ImuBuffer::Rejections ImuBuffer::TakeRejections() {
   return r;
 }
 
-std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap) const {
-  const std::deque<ImuSample>& imu = samples_;
+double ImuBuffer::ConstantSeconds() const {
+  double longest = 0.0;
+  for (const ConstantImuDetector& d : constant_) longest = std::max(longest, d.ConstantSeconds());
+  return longest;
+}
+
+const std::deque<ImuSample>& ImuBuffer::samples(int imu) const {
+  static const std::deque<ImuSample> kNone;
+  return imu >= 0 && imu < num_imus() ? streams_[imu] : kNone;
+}
+
+std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_gap,
+                                            int imu_index) const {
+  const std::deque<ImuSample>& imu = samples(imu_index);
   std::vector<ImuSegment> out;
   double gap = 0.0;
   if (imu.empty() || t_b <= t_a) {
@@ -83,15 +104,15 @@ std::vector<ImuSegment> ImuBuffer::Segments(double t_a, double t_b, double* max_
   return out;
 }
 
-double ImuBuffer::MaxGap(double t_a, double t_b) const {
+double ImuBuffer::MaxGap(double t_a, double t_b, int imu) const {
   double gap = 0.0;
-  Segments(t_a, t_b, &gap);
+  Segments(t_a, t_b, &gap, imu);
   return gap;
 }
 
-std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b) const {
+std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b, int imu) const {
   std::vector<ImuSample> out;
-  for (const ImuSample& s : samples_) {
+  for (const ImuSample& s : samples(imu)) {
     const double t = Seconds(s.t_ns);
     if (t > t_a && t <= t_b) out.push_back(s);
   }
@@ -99,7 +120,9 @@ std::vector<ImuSample> ImuBuffer::Samples(double t_a, double t_b) const {
 }
 
 void ImuBuffer::Trim(double t) {
-  while (samples_.size() > 1 && Seconds(samples_[1].t_ns) <= t) samples_.pop_front();
+  for (std::deque<ImuSample>& samples : streams_) {
+    while (samples.size() > 1 && Seconds(samples[1].t_ns) <= t) samples.pop_front();
+  }
 }
 
 }  // namespace ctlio::lio

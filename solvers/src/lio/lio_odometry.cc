@@ -1,5 +1,7 @@
 #include "ctlio/solvers/lio/lio_odometry.h"
 
+#include <ceres/covariance.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <stdexcept>
 
 #include "ctlio/factors/priors/pose_prior.h"
+#include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/input_checks.h"
 
@@ -92,6 +95,15 @@ std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double ra
   const std::vector<SE3> poses = estimator_->PosesSincePrevious(t);
   for (size_t i = 0; i < ns.size(); ++i) out.emplace_back(ns[i], poses[i]);
   return out;
+}
+
+bool LioOdometry::AddImu(const ImuSample& sample) {
+  if (sample.imu >= config_.num_imus()) {
+    throw std::invalid_argument("LioOdometry::AddImu: sample of IMU " + std::to_string(sample.imu) +
+                                ", the config declares " + std::to_string(config_.num_imus()) +
+                                " (imus:)");
+  }
+  return imu_.AddImu(sample);
 }
 
 ScanResult LioOdometry::AddScan(const LidarScan& input) {
@@ -210,6 +222,26 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
+  if (config_.pose_covariance) ReportPoseCovariance(result);
+}
+
+void LioOdometry::ReportPoseCovariance(ScanResult* result) {
+  double* pose = window_.State(estimator_->NewestPoseKey());
+  // Sparse QR of the window's Jacobian (the default); a rank-deficient window gives no
+  // covariance (the scan then has none) rather than a pseudo-inverse.
+  ceres::Covariance covariance(ceres::Covariance::Options{});
+  const std::vector<std::pair<const double*, const double*>> blocks = {{pose, pose}};
+  if (!covariance.Compute(blocks, &window_.problem())) return;
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
+  if (!covariance.GetCovarianceBlockInTangentSpace(pose, pose, block.data())) return;
+  Mat6 sigma = block;
+  if (estimator_->PoseBlockIsInverse()) {
+    // Block T_rm ← Exp(δ)·T_rm, so T_mr ← T_mr·Exp(−δ) = Exp(−Ad(T_mr)·δ)·T_mr.
+    const Mat6 ad = result->T_mr.Adjoint();
+    sigma = ad * sigma * ad.transpose();
+  }
+  result->pose_covariance = sigma;
+  result->has_pose_covariance = true;
 }
 
 void LioOdometry::Slide(ScanResult* result) {
@@ -273,7 +305,12 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
 
 void LioOdometry::ReportImuGap(double t_begin, double t_end, ScanResult* result) const {
   if (!uses_imu()) return;
-  const double max_gap = imu_.MaxGap(t_begin, t_end);
+  double max_gap = imu_.MaxGap(t_begin, t_end, config_.input_imu);
+  if (config_.method != LioMethod::kImuInput) {
+    for (int j = 0; j < config_.num_imus(); ++j) {
+      max_gap = std::min(max_gap, imu_.MaxGap(t_begin, t_end, j));
+    }
+  }
   if (max_gap <= config_.max_imu_gap) return;
   std::ostringstream m;
   m << "IMU gap of " << max_gap << " s (limit " << config_.max_imu_gap

@@ -90,6 +90,19 @@ NavStateEstimator::State NavStateEstimator::AddNavState(double t, const SE3& T_w
   return s;
 }
 
+std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
+                                                         double* max_gap) const {
+  std::vector<ImuSegment> segments = imu_.Segments(t_a, t_b, max_gap, config_.input_imu);
+  const Mat3 C_ri = config_.ImuPose(config_.input_imu).rotation();
+  if (!C_ri.isIdentity(0.0)) {
+    for (ImuSegment& seg : segments) {
+      seg.gyro = C_ri * seg.gyro;
+      seg.accel = C_ri * seg.accel;
+    }
+  }
+  return segments;
+}
+
 NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end) const {
   DeskewTable table;
   const Vec6 bias = Eigen::Map<const Vec6>(from.bias);
@@ -97,7 +110,7 @@ NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, d
   const imu::NavState start = ReadNavState(from);
   table.t.push_back(from.t);
   table.T_wb.push_back(PoseManifold::Pose(from.pose));
-  for (const ImuSegment& seg : imu_.Segments(from.t, t_end, nullptr)) {
+  for (const ImuSegment& seg : InputSegments(from.t, t_end, nullptr)) {
     pim.Integrate(seg.accel, seg.gyro, seg.dt);
     const imu::NavState x = pim.Predict(start, bias, gravity_map_);
     table.t.push_back(seg.t_begin + seg.dt);
@@ -189,7 +202,7 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
                                  ScanResult* result) {
   const State prev = states_.back();
   double max_gap = 0.0;
-  const std::vector<ImuSegment> segments = imu_.Segments(prev.t, scan.t_end, &max_gap);
+  const std::vector<ImuSegment> segments = InputSegments(prev.t, scan.t_end, &max_gap);
   if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.gap_hold_max)) {
     AddStateAcrossGap(prev, scan.t_end, window);
     result->imu_residuals = 0;

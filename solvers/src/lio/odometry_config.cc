@@ -113,6 +113,13 @@ void OdometryConfig::Validate() const {
   require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(window_knots >= 2, "window.knots must be >= 2");
+  require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
+  for (const ImuSensor& s : imus) {
+    require(s.accel_variance >= 0 && s.gyro_variance >= 0, "imus[].variances must be >= 0");
+  }
+  // (Without `imus` the dataset may still declare them: RunOdometry fills the list.)
+  require(input_imu >= 0 && input_imu < (imus.empty() ? 5 : num_imus()),
+          "imu.input_imu must index an IMU of imus");
   require(solver_threads >= 1, "window solver settings must be >= 1");
   degeneracy.Validate();
 }
@@ -127,6 +134,7 @@ struct TopLevel {
   Vec6 extrinsic_xyz_rpy = Vec6::Zero();
   std::vector<double> extrinsic_rotation;  // optional 3×3 row-major
   YAML::Node per_method;
+  YAML::Node imus;
 };
 
 // Applies the sections of the mapping `root` onto *c: keys absent keep *c's values. `top` is
@@ -139,7 +147,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     const YAML::Node& v = kv.second;
     const std::string section = where + key;
     if (top == nullptr &&
-        (key == "method" || key == "extrinsic" || key == "input" || key == "per_method")) {
+        (key == "method" || key == "extrinsic" || key == "input" || key == "per_method" ||
+         key == "imus")) {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": '" + section +
                                "' cannot be set per method");
     }
@@ -151,6 +160,12 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                                  ": 'per_method' must be a mapping of method names");
       }
       top->per_method = v;
+    } else if (key == "imus") {
+      if (!v.IsSequence()) {
+        throw std::runtime_error(YamlWhere(source, v.Mark()) +
+                                 ": 'imus' must be a list of IMU mappings");
+      }
+      top->imus = v;
     } else if (key == "gp") {
       ReadSection(v, section, source, {{"qc", SetVec6(&c->qc)}, {"alpha", SetVec6(&c->alpha)}});
     } else if (key == "imu") {
@@ -170,7 +185,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"rate_hint", SetFromYaml(&c->imu_rate_hint)},
                    {"gap_velocity_walk", SetFromYaml(&c->gap_velocity_walk)},
                    {"gap_hold_max", SetFromYaml(&c->gap_hold_max)},
-                   {"gap_zero_order_hold", SetFromYaml(&c->gap_zero_order_hold)}});
+                   {"gap_zero_order_hold", SetFromYaml(&c->gap_zero_order_hold)},
+                   {"input_imu", SetFromYaml(&c->input_imu)}});
     } else if (key == "init") {
       ReadSection(v, section, source,
                   {{"gravity_duration", SetFromYaml(&c->gravity_init_duration)},
@@ -182,7 +198,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
       ReadSection(v, section, source,
                   {{"knots", SetFromYaml(&c->window_knots)},
                    {"threads", SetFromYaml(&c->solver_threads)},
-                   {"estimate_gravity", SetFromYaml(&c->estimate_gravity)}});
+                   {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
+                   {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,
@@ -230,6 +247,14 @@ void ValidateNaming(const OdometryConfig& c, const std::string& source, const st
 
 }  // namespace
 
+double OdometryConfig::AccelVariance(int j) const {
+  return imus.empty() || imus[j].accel_variance <= 0 ? accel_variance : imus[j].accel_variance;
+}
+
+double OdometryConfig::GyroVariance(int j) const {
+  return imus.empty() || imus[j].gyro_variance <= 0 ? gyro_variance : imus[j].gyro_variance;
+}
+
 OdometryConfig OdometryConfig::ForMethod(LioMethod m) const {
   const auto it = per_method.find(m);
   OdometryConfig c = it == per_method.end() ? *this : *it->second;
@@ -266,6 +291,30 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
               .toRotationMatrix();
     }
     c.T_imu_lidar = SE3(C, top.extrinsic_xyz_rpy.head<3>());
+  }
+  if (top.imus) {
+    for (size_t j = 0; j < top.imus.size(); ++j) {
+      const std::string section = "imus[" + std::to_string(j) + "]";
+      Vec6 xyz_rpy = Vec6::Zero();
+      OdometryConfig::ImuSensor sensor;
+      ReadSection(top.imus[j], section, source,
+                  {{"xyz_rpy", SetVec6(&xyz_rpy)},
+                   {"translation",
+                    [&xyz_rpy](const YAML::Node& n) {
+                      const auto t = n.as<std::vector<double>>();
+                      if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
+                      xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
+                    }},
+                   {"accel_variance", SetFromYaml(&sensor.accel_variance)},
+                   {"gyro_variance", SetFromYaml(&sensor.gyro_variance)}});
+      const Vec3 rpy = xyz_rpy.tail<3>();
+      const Mat3 C =
+          (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+           Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+              .toRotationMatrix();
+      sensor.T_robot_imu = SE3(C, xyz_rpy.head<3>());
+      c.imus.push_back(sensor);
+    }
   }
   ValidateNaming(c, source, "");
   // Per-method overrides: each applied onto the complete base (whatever the key order).

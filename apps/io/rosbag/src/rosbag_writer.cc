@@ -51,6 +51,7 @@ nav_msgs::Odometry OdometryMsg(const StampedPose& p, const std::string& frame,
 
 size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWriteOptions& options,
                    const std::function<void(size_t, size_t)>& progress) {
+  RequireFirstImuInBodyFrame(source, path + " (ROS bag)");
   try {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
     if (options.compression == "lz4") {
@@ -84,6 +85,7 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
       }
       first = false;
       for (const ImuSample& s : frame.imu) {
+        if (s.imu != 0) continue;  // one IMU topic: the first IMU (Imus()[0])
         sensor_msgs::Imu m;
         m.header.stamp = RosTime(s.t_ns);
         m.header.frame_id = options.imu_frame;

@@ -21,6 +21,20 @@ namespace ctlio::io {
 // as the factors' and the odometry's (no conversion anywhere).
 using ImuSample = imu::ImuSample;
 
+// One IMU of a dataset. The robot (body) frame of the odometry is the frame ImuFromLidar()
+// maps lidar points into; with one IMU it is that IMU's frame (T_body_imu = identity), with
+// several each IMU sits at its own T_body_imu (rotation and lever arm).
+struct ImuInfo {
+  std::string name = "imu0";
+  SE3 T_body_imu;        // maps IMU coordinates into the body frame
+  double rate_hz = 0.0;  // nominal rate (0 = unknown)
+  // Per-sample standard deviations when the dataset states them (0 = unknown).
+  double accel_sigma = 0.0;  // m/s²
+  double gyro_sigma = 0.0;   // rad/s
+  // The true initial biases [b_a; b_g] when known (simulated data), for evaluation only.
+  std::optional<Vec6> true_bias;
+};
+
 // A timestamped pose. In ground truth it is T_world_lidar: the lidar frame's pose in a fixed world
 // frame (maps lidar coordinates into world coordinates, SPEC §1).
 struct StampedPose {
@@ -29,8 +43,9 @@ struct StampedPose {
 };
 
 // One lidar scan plus the IMU samples with times in (end of the previous scan, end of this scan];
-// the first scan also gets every earlier sample. `cloud.times_ns` are absolute and always present
-// (sources without per-point times are rejected or documented to fill them).
+// the first scan also gets every earlier sample. With several IMUs the samples of all of them
+// are in one time-sorted list, each tagged with ImuSample::imu. `cloud.times_ns` are absolute and
+// always present (sources without per-point times are rejected or documented to fill them).
 struct ScanFrame {
   size_t index = 0;
   int64_t start_ns = 0;  // scan stamp (= cloud.stamp_ns)
@@ -57,12 +72,24 @@ class DataSource {
   virtual std::optional<std::vector<StampedPose>> GroundTruth() const { return std::nullopt; }
   // Gravity magnitude the IMU data assume, if the source knows it (simulator: exact value).
   virtual std::optional<double> Gravity() const { return std::nullopt; }
+  // The IMUs whose samples the scans carry (ImuSample::imu indexes this list); one IMU in the
+  // body frame unless the source says otherwise.
+  virtual std::vector<ImuInfo> Imus() const { return {ImuInfo{}}; }
 };
+
+// The samples of several time-sorted IMU streams in one time-sorted list, each sample tagged
+// with its stream's index (at equal times the lower index first).
+std::vector<ImuSample> MergeImuStreams(const std::vector<std::vector<ImuSample>>& streams);
 
 // Groups a time-sorted IMU stream and scans: appends the samples with start < t ≤ end to *out,
 // advancing *cursor. Used by every reader so that "IMU between scans" means the same everywhere.
 void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cursor,
                   std::vector<ImuSample>* out);
+
+// For the single-IMU layouts (Newer College, ROS bag): they hold the first IMU only, whose frame
+// must be the body frame; throws naming `target` otherwise and warns that further IMUs are left
+// out.
+void RequireFirstImuInBodyFrame(const DataSource& source, const std::string& target);
 
 // Recovery shared by the readers: drops the points of `cloud` timed outside [lo_ns, hi_ns] (the
 // scan's interval with a tolerance), with a warning naming `path`. Returns how many.

@@ -9,6 +9,10 @@
 // IMU (SPEC §3):  gyro  = ω + b_g + n_g,
 //                 accel = v̇ + ω×v − C_wbᵀ g_w + b_a + n_a   (exact specific force), or
 //                 accel = v̇       − C_wbᵀ g_w + b_a + n_a   (`body_centric`: the paper's model).
+// Several IMUs (SimConfig::extra_imus): IMU j sits at T_bi = body_from_imu (rotation C_bi, lever
+// arm p) with its own rate, clock start, noise, biases and outages, and reads the rigid-body
+// motion of its own origin (imu_mounting.h): ω_i = C_biᵀ ω, f_i = C_biᵀ(f_b + ω̇×p + ω×(ω×p)),
+// f_b the body-origin specific force above.
 // Motion (SPEC §6): stationary until `start_s`, then each of the six body-twist axes j follows
 // amp_j·sin(2π f_j (t − start_s)), so the twist is continuous at start_s. Outside the box room
 // (and for the walking and vehicle regimes everywhere) the motion is guided along the world's
@@ -124,6 +128,10 @@ struct ImuConfig {
   std::vector<ImuOutage> outages;
   double outage_rate = 0.0;
   double outage_length_min = 0.1, outage_length_max = 1.0;
+  // Mounting and clock: T_body_imu (identity: the IMU frame is the body frame), and the time of
+  // the first sample after the sequence start [s] (samples at start + offset + k/rate).
+  SE3 body_from_imu;
+  double clock_offset_s = 0.0;
 };
 
 struct SimConfig {
@@ -136,8 +144,11 @@ struct SimConfig {
   int64_t start_ns = 0;                                        // absolute time of t = 0
   SE3 world_from_imu0 = SE3(Mat3::Identity(), Vec3(0, 0, 2));  // T_wb(0) (unguided motion)
   SE3 imu_from_lidar;                                          // T_bl (identity by default)
-  uint64_t seed = kExperimentSeed;                             // noise seed
-  double integration_step_s = 1e-4;                            // ground-truth pose grid
+  // Further IMUs (IMU 1, 2, ...; `imu` is IMU 0). Each gets its own noise stream, so IMU 0's
+  // samples are the same with or without them.
+  std::vector<ImuConfig> extra_imus;
+  uint64_t seed = kExperimentSeed;   // noise seed
+  double integration_step_s = 1e-4;  // ground-truth pose grid
 };
 
 // The configuration of sequence `index` of a regime: DrawMotion + noise seed {seed, regime, index}.
@@ -159,13 +170,21 @@ class LidarInertialSim {
   Vec6 BodyTwistRate(double t) const;
   SE3 WorldFromImu(double t) const;
   SE3 WorldFromLidar(double t) const { return WorldFromImu(t) * config_.imu_from_lidar; }
-  // Noise-free IMU reading at t (biases excluded).
-  io::ImuSample TrueImu(double t) const;
+  // Noise-free IMU reading at t (biases excluded) of an IMU at T_body_imu (default: the body
+  // frame).
+  io::ImuSample TrueImu(double t, const SE3& body_from_imu = SE3()) const;
 
-  // The noisy IMU stream with biases, every sample of the sequence.
-  const std::vector<io::ImuSample>& Imu() const { return imu_; }
-  // Bias [b_a; b_g] at IMU sample j (constant unless a random walk is configured).
-  const std::vector<Vec6>& ImuBiases() const { return biases_; }
+  // IMU 0, 1, ...: the configuration (imu, then extra_imus).
+  size_t NumImus() const { return imu_.size(); }
+  const ImuConfig& ImuConfigOf(size_t j) const {
+    return j == 0 ? config_.imu : config_.extra_imus.at(j - 1);
+  }
+  // The noisy IMU stream of IMU j with biases, every sample of the sequence (tagged imu = j).
+  const std::vector<io::ImuSample>& Imu(size_t j = 0) const { return imu_.at(j); }
+  // Every IMU's samples in one time-sorted stream (the data source hands this out).
+  const std::vector<io::ImuSample>& AllImu() const { return all_imu_; }
+  // Bias [b_a; b_g] of IMU `imu` at its sample j (constant unless a random walk is configured).
+  const std::vector<Vec6>& ImuBiases(size_t imu = 0) const { return biases_.at(imu); }
 
   size_t NumScans() const;
   int64_t ScanStartNs(size_t k) const;
@@ -177,17 +196,18 @@ class LidarInertialSim {
   double CastRay(const Vec3& origin, const Vec3& direction) const;
   // The world's geometry and path; the realised IMU outages (given and random).
   const World& world() const { return world_; }
-  const std::vector<ImuOutage>& ImuOutages() const { return outages_; }
+  const std::vector<ImuOutage>& ImuOutages(size_t imu = 0) const { return outages_.at(imu); }
 
  private:
   SimConfig config_;
   World world_;
-  double path_start_ = 0.0;  // arc length where the guided motion starts
-  std::vector<ImuOutage> outages_;
+  double path_start_ = 0.0;                            // arc length where the guided motion starts
+  std::vector<std::vector<ImuOutage>> outages_;        // per IMU
   std::vector<double> beam_el_error_, beam_az_error_;  // radians, per beam
   std::vector<SE3> grid_;                              // T_wb at multiples of integration_step_s
-  std::vector<io::ImuSample> imu_;
-  std::vector<Vec6> biases_;
+  std::vector<std::vector<io::ImuSample>> imu_;        // per IMU
+  std::vector<std::vector<Vec6>> biases_;              // per IMU
+  std::vector<io::ImuSample> all_imu_;
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
   SE3 MagnusStep(const SE3& T, double t, double h) const;
   // The body-rate motion P (SPEC §6 sinusoids) and its pose integrated on the grid.
@@ -196,7 +216,9 @@ class LidarInertialSim {
   SE3 LocalPose(double t) const;
   // The nearest surface along a ray (normals only where realism needs them in the box room).
   RayHit Cast(const Vec3& o, const Vec3& d) const;
-  void ApplyImuOutages();
+  // IMU j's samples, biases and outages (IMU 0 draws from the single-IMU streams).
+  void GenerateImu(size_t j);
+  void ApplyImuOutages(size_t j);
 };
 
 // The simulator as a data source, generating each scan in memory when asked (SPEC §6: a
@@ -211,6 +233,7 @@ class SimulatedSource : public io::DataSource {
   SE3 ImuFromLidar() const override { return sim_.config().imu_from_lidar; }
   std::optional<std::vector<io::StampedPose>> GroundTruth() const override;
   std::optional<double> Gravity() const override { return sim_.config().imu.gravity; }
+  std::vector<io::ImuInfo> Imus() const override;
   const LidarInertialSim& simulator() const { return sim_; }
 
  private:

@@ -17,6 +17,9 @@ struct ImuSample {
   std::int64_t t_ns = 0;
   Vec3 gyro = Vec3::Zero();   // rad/s, sensor frame
   Vec3 accel = Vec3::Zero();  // m/s², specific force, sensor frame
+  // Which IMU of the dataset took the sample (index into io::DataSource::Imus(); 0 with a single
+  // IMU). Each IMU has its own clock grid, mounting, noise and biases.
+  int imu = 0;
 };
 
 // Integrates the samples covering [t0_ns, t1_ns] with a zero-order hold (sample

@@ -4,6 +4,9 @@
 // linearly between knots, gravity C_mi from the initialisation), a bias random walk between
 // knots, and the keypoints as ContinuousPointToPlane residuals (ContinuousLidarTerm). The
 // `lidar_gyro` method drops the accelerometer; `lidar_only` drops the IMU and the biases.
+// Several IMUs (OdometryConfig::imus): every sample of every IMU is a measurement of the state at
+// its own time with its IMU's mounting (lever arm and rotation, imu_mounting.h) and noise, and
+// each IMU has its own bias blocks (KnotKeys::Bias) with their own random walk.
 #pragma once
 
 #include <deque>
@@ -12,6 +15,7 @@
 #include <vector>
 
 #include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/imu/imu_mounting.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/state_keys.h"
 
@@ -40,6 +44,8 @@ class GpKnotEstimator final : public Estimator {
   double previous_time() const override { return knots_[knots_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
+  StateId NewestPoseKey() const override { return knots_.back().keys.pose; }
+  bool PoseBlockIsInverse() const override { return true; }
 
  private:
   // A knot's blocks live in the window (which owns the storage).
@@ -49,21 +55,25 @@ class GpKnotEstimator final : public Estimator {
     double* pose = nullptr;
     double* velocity = nullptr;
     double* acceleration = nullptr;
-    double* bias = nullptr;  // nullptr for lidar_only
+    std::vector<double*> bias;  // per IMU; empty for lidar_only
   };
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
-  Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw, const Vec6& bias,
-               SlidingWindow* window);
+  int num_imus() const { return uses_imu() ? config_.num_imus() : 0; }
+  // `bias`: the initial value of every IMU's bias, per IMU.
+  Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw,
+               const std::vector<Vec6>& bias, SlidingWindow* window);
   // T_mr(τ) between knots a and b from the current estimates (GP interpolation, SPEC §2).
   SE3 PoseAt(const Knot& a, const Knot& b, double tau) const;
-  // Gyro and accelerometer samples in (prev.t, k.t] as measurements (SPEC §3).
-  void AddImuMeasurements(const Knot& prev, const Knot& k, const std::vector<ImuSample>& imu,
-                          SlidingWindow* window, ScanResult* result) const;
+  // Gyro and accelerometer samples of IMU `imu` in (prev.t, k.t] as measurements (SPEC §3).
+  void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
+                          const std::vector<ImuSample>& samples, SlidingWindow* window,
+                          ScanResult* result) const;
 
   OdometryConfig config_;
   const ImuBuffer& imu_;
   gp::SingerModel<6> model_;
-  std::deque<Knot> knots_;  // oldest first
+  std::vector<imu::ImuMounting> mountings_;  // per IMU
+  std::deque<Knot> knots_;                   // oldest first
   int64_t next_knot_ = 0;
 };
 

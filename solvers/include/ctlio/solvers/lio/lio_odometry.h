@@ -36,11 +36,12 @@ class LioOdometry {
   LioOdometry(const LioOdometry&) = delete;
   LioOdometry& operator=(const LioOdometry&) = delete;
 
-  // Throws std::invalid_argument if the sample is older than the previous one (a duplicate
-  // timestamp is dropped and counted in duplicate_imu_samples()). A sample that cannot be
-  // physical (not finite, beyond config.input.max_gyro / max_accel) is rejected and counted in the
-  // next ScanResult (imu_rejected, message); returns false then.
-  bool AddImu(const ImuSample& sample) { return imu_.AddImu(sample); }
+  // Throws std::invalid_argument if the sample is older than the previous one of its IMU, or of
+  // an IMU the config does not declare (OdometryConfig::imus); a duplicate timestamp is dropped
+  // and counted in duplicate_imu_samples(). A sample that cannot be physical (not finite, beyond
+  // config.input.max_gyro / max_accel) is rejected and counted in the next ScanResult
+  // (imu_rejected, message); returns false then.
+  bool AddImu(const ImuSample& sample);
   // Processes one scan. Throws std::invalid_argument for a scan out of order or with mismatched
   // point/time arrays; everything else (too few points, IMU gaps, failed initialisation,
   // divergence, points outside the scan's interval, a frozen IMU) is reported in the result.
@@ -82,7 +83,12 @@ class LioOdometry {
   // Schur-complement marginalisation of the oldest states until window_knots − 1 remain, before
   // the new state is added (SPEC §5): their information is kept in one prior, not dropped.
   void Slide(ScanResult* result);
+  // A scan is gapped if the IMU(s) the estimator uses all have a hole above init.max_imu_gap
+  // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
+  // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
+  // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
+  void ReportPoseCovariance(ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;

@@ -46,6 +46,8 @@ class NavStateEstimator final : public Estimator {
   double previous_time() const override { return states_[states_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override;
+  StateId NewestPoseKey() const override { return states_.back().keys.pose; }
+  bool PoseBlockIsInverse() const override { return false; }
 
   // A state's blocks live in the window.
   struct State {
@@ -72,6 +74,9 @@ class NavStateEstimator final : public Estimator {
   DeskewTable Deskew(const State& from, const State& to) const;
 
  private:
+  // The zero-order-hold signal of the input IMU (config.input_imu) over [t_a, t_b], rotated into
+  // the robot frame. Its lever arm is not modelled: ω̇×p would need the derivative of the gyro.
+  std::vector<ImuSegment> InputSegments(double t_a, double t_b, double* max_gap) const;
   State AddNavState(double t, const SE3& T_wb, const Vec3& v, const Vec6& bias,
                     SlidingWindow* window);
   // Across an IMU gap: the constant-twist prediction and the velocity random walk.

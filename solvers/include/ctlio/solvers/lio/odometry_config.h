@@ -103,6 +103,31 @@ struct OdometryConfig {
   // --- Plausibility gates on the input (input_checks.h), applied by LioOdometry; YAML `input:`.
   InputCheckOptions input;
 
+  // --- Several IMUs (top-level YAML key `imus`, or the dataset's IMUs; ImuSample::imu indexes
+  // the list). Empty: one IMU whose frame is the robot frame, with the variances above. Otherwise
+  // IMU j sits at T_robot_imu (imu_mounting.h) and has its own variances (0 = the `imu`
+  // section's), its own bias states and their random walk (the `imu` section's parameters).
+  // Singer-LIO and lidar_gyro take every sample of every IMU as a measurement; the IMU-as-input
+  // baseline preintegrates one IMU, `input_imu` (imu.input_imu), rotated into the robot frame
+  // (its lever arm is not modelled: that would need the derivative of the gyro).
+  struct ImuSensor {
+    SE3 T_robot_imu;
+    double accel_variance = 0.0;  // (m/s²)²
+    double gyro_variance = 0.0;   // (rad/s)²
+  };
+  std::vector<ImuSensor> imus;
+  int input_imu = 0;
+  int num_imus() const { return imus.empty() ? 1 : static_cast<int>(imus.size()); }
+  // The mounting and the sample variances of IMU j.
+  SE3 ImuPose(int j) const { return imus.empty() ? SE3() : imus[j].T_robot_imu; }
+  double AccelVariance(int j) const;
+  double GyroVariance(int j) const;
+
+  // Consistency: after every scan, the covariance of the newest pose (ceres::Covariance of the
+  // window at the solution) into ScanResult::pose_covariance (window.pose_covariance). Off by
+  // default: it costs one more Jacobian evaluation and a factorisation per scan.
+  bool pose_covariance = false;
+
   // --- Per-method overrides (YAML key `per_method`): the complete configuration to use when
   // running that method, i.e. this one with the override's keys replaced. One file can so
   // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side.
@@ -146,7 +171,11 @@ struct ScanResult {
   int64_t t_ns = 0;              // scan end (knot time)
   SE3 T_mr;                      // robot pose in the map (T_rm⁻¹) at t_ns
   Vec6 velocity = Vec6::Zero();  // [v; ω] body frame (Singer: −ϖ; baseline: C_rmᵀ v_m)
-  Vec6 bias = Vec6::Zero();      // [b_a; b_g]
+  Vec6 bias = Vec6::Zero();      // [b_a; b_g] (of IMU 0)
+  std::vector<Vec6> imu_biases;  // [b_a; b_g] of every IMU (Singer-LIO, lidar_gyro)
+  // With OdometryConfig::pose_covariance: Σ of ε in T_mr(true) = Exp(ε)·T_mr (6×6, [ρ; φ]).
+  bool has_pose_covariance = false;
+  Mat6 pose_covariance = Mat6::Zero();
   ScanStatus status = ScanStatus::kOk;
   std::string message;  // why, for anything but kOk; also the input gates' notes (below)
   // Input gates (input_checks.h): IMU samples rejected since the previous scan (beyond the

@@ -14,11 +14,13 @@ namespace ctlio::lio {
 // C_mi, the gravity-aligned frame i → map frame m (a RotationManifold block, SPEC §3).
 inline constexpr StateId kGravityKey = -1;
 
-// A GP knot of Singer-LIO (SPEC §2, §3): pose T_rm, ϖ, ϖ̇ and the IMU biases [b_a; b_g].
+// A GP knot of Singer-LIO (SPEC §2, §3): pose T_rm, ϖ, ϖ̇ and the IMU biases [b_a; b_g], one
+// bias block per IMU: IMU j's is 8n + 3 + j (j < 5; `bias` is IMU 0's).
 struct KnotKeys {
   StateId pose = 0, velocity = 0, acceleration = 0, bias = 0;
 
   static KnotKeys ForKnot(int64_t n) { return {8 * n, 8 * n + 1, 8 * n + 2, 8 * n + 3}; }
+  StateId Bias(int imu) const { return bias + imu; }
   // The blocks of the GP state γ = {T, ϖ, ϖ̇} (the motion prior and the interpolation use these).
   std::vector<StateId> Motion() const { return {pose, velocity, acceleration}; }
 };
