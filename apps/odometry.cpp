@@ -83,6 +83,11 @@ DEFINE_double(max_imu_gap_error, 0.0,
               "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
               "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
+DEFINE_int32(frontend_threads, 1,
+             "Threads of the lidar front end (association, range gate): lidar_frontend.threads "
+             "of the config unless given; same results as one thread");
+DEFINE_string(association, "",
+              "Override lidar_frontend.association of the config: knn | voxel_plane");
 DEFINE_string(sim_preset, "",
               "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
@@ -223,6 +228,10 @@ int main(int argc, char** argv) {
       lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
       if (gap_flag) config.input.max_imu_gap_error = FLAGS_max_imu_gap_error;
       if (FLAGS_pose_covariance) config.pose_covariance = true;
+      if (!gflags::GetCommandLineFlagInfoOrDie("frontend_threads").is_default) {
+        config.frontend.threads = FLAGS_frontend_threads;
+      }
+      if (!FLAGS_association.empty()) config.frontend.association = FLAGS_association;
       config.Validate();
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <random>
+#include <set>
 #include <tuple>
 
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
@@ -118,6 +120,105 @@ TEST(Frontend, AssociationGate) {
   EXPECT_FALSE(associator.Associate(q, Vec3(0.3, 0.2, 2.5), &a));
 }
 
+// The voxel-plane association answers from the map's per-voxel plane where the voxel holds
+// min_neighbours points, and falls back to the kNN plane where it does not.
+TEST(Frontend, VoxelPlaneAssociationAndFallback) {
+  LidarFrontendOptions options;
+  options.association = "voxel_plane";
+  LidarFrontendOptions knn_options;  // association "knn"
+  VoxelMap map(LidarFrontend::MapOptions(options));
+  ASSERT_TRUE(map.options().fit_planes);
+  // The tilted plane z = 0.1·x + 0.05·y with ±1 mm checkerboard relief, every 0.25 m (16 points
+  // per voxel) for x < 2; for x in [2, 3) every 0.5 m (4 points per voxel, < min_neighbours).
+  const auto z = [](double x, double y) { return 0.1 * x + 0.05 * y; };
+  int n = 0;
+  for (double x = -5; x < 2.0; x += 0.25)
+    for (double y = -5; y <= 5; y += 0.25)
+      map.Insert(Vec3(x, y, z(x, y) + (n++ % 2 ? 1e-3 : -1e-3)));
+  for (double x = 2.0; x < 3.0; x += 0.5)
+    for (double y = -5; y <= 5; y += 0.5) map.Insert(Vec3(x, y, z(x, y)));
+  const Vec3 normal = Vec3(-0.1, -0.05, 1.0).normalized();
+  PlaneAssociator voxel_planes(map, options);
+  PlaneAssociator knn(map, knn_options);
+  const Vec3 q(1.0, 2.0, 3.0);
+  // Inside a dense voxel: exactly the map's plane of that voxel.
+  const Vec3 p(0.3, 0.6, z(0.3, 0.6) + 0.02);
+  PlaneAssociation a, b, c;
+  ASSERT_TRUE(voxel_planes.Associate(q, p, &a));
+  const VoxelPlane* plane = map.PlaneOf(p);
+  ASSERT_NE(plane, nullptr);
+  EXPECT_GE(plane->points, options.min_neighbours);
+  EXPECT_EQ(a.plane_point, plane->fit.centroid);
+  EXPECT_EQ(a.plane_normal, plane->fit.normal);
+  EXPECT_EQ(a.weight, plane->fit.planarity_weight);
+  EXPECT_GT(std::abs(a.plane_normal.dot(normal)), 1.0 - 1e-4);
+  EXPECT_NEAR(normal.dot(a.plane_point), 0.0, 1e-3);  // the centroid lies on the plane
+  ASSERT_TRUE(knn.Associate(q, p, &b));
+  EXPECT_NE(a.plane_point, b.plane_point);  // a different point set: not the kNN plane
+  // The same voxel with a thickness limit under its σ3 (~1 mm): the kNN plane instead.
+  ASSERT_GT(plane->fit.sigma3, 5e-4);
+  LidarFrontendOptions thin = options;
+  thin.voxel_plane_max_thickness = 0.5 * plane->fit.sigma3;
+  ASSERT_TRUE(PlaneAssociator(map, thin).Associate(q, p, &c));
+  EXPECT_EQ(c.plane_point, b.plane_point);
+  EXPECT_EQ(c.plane_normal, b.plane_normal);
+  // Inside a sparse voxel: the kNN plane, identical to the kNN associator's.
+  const Vec3 sparse(2.4, 0.3, z(2.4, 0.3));
+  ASSERT_NE(map.PlaneOf(sparse), nullptr);
+  EXPECT_LT(map.PlaneOf(sparse)->points, options.min_neighbours);
+  ASSERT_TRUE(voxel_planes.Associate(q, sparse, &a));
+  ASSERT_TRUE(knn.Associate(q, sparse, &b));
+  EXPECT_EQ(a.plane_point, b.plane_point);
+  EXPECT_EQ(a.plane_normal, b.plane_normal);
+  EXPECT_EQ(a.weight, b.weight);
+  // The distance gate applies to the voxel plane too (p is 2 cm off the plane); an empty voxel
+  // without neighbours fails.
+  LidarFrontendOptions tight = options;
+  tight.max_plane_distance = 0.01;
+  EXPECT_FALSE(PlaneAssociator(map, tight).Associate(q, p, &a));
+  EXPECT_FALSE(voxel_planes.Associate(q, Vec3(0.3, 0.2, 2.5), &a));
+  // A voxel_plane associator needs a map that keeps planes.
+  VoxelMap plain(VoxelMap::Options{});
+  EXPECT_THROW(PlaneAssociator(plain, options), std::invalid_argument);
+}
+
+// The one-pass range gate + subsampling against a reference built on std::floor voxel keys and
+// an ordered set, with points on and just beside voxel boundaries (negative ones included, where
+// the floor-free key must round down), for 1, 2 and 3 threads (same indices).
+TEST(Frontend, RangeGatedVoxelIndicesMatchesReferenceForAnyThreads) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-30.0, 30.0);
+  std::uniform_int_distribution<int> cell(-60, 60);
+  std::vector<Vec3> raw;
+  for (int i = 0; i < 70000; ++i) {
+    if (i % 5 == 0) {  // exactly on a 0.5 m boundary, or one ulp beside it
+      Vec3 p(0.5 * cell(rng), 0.5 * cell(rng), 0.5 * cell(rng));
+      if (i % 3 == 1) p.x() = std::nextafter(p.x(), -1e9);
+      if (i % 3 == 2) p.y() = std::nextafter(p.y(), 1e9);
+      raw.push_back(p);
+    } else {
+      raw.emplace_back(u(rng), u(rng), 0.2 * u(rng));
+    }
+    if (i % 997 == 0) raw.back() = Vec3(0.2, 0.0, 0.0);  // inside min_range
+    if (i % 1999 == 0) raw.back() = Vec3(std::nan(""), 1.0, 1.0);
+  }
+  std::vector<size_t> reference;
+  std::set<std::tuple<int, int, int>> seen;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    const double r2 = raw[i].squaredNorm();
+    if (!(r2 >= 1.0 && r2 <= 40.0 * 40.0)) continue;
+    const auto key = std::make_tuple(static_cast<int>(std::floor(raw[i].x() / 0.5)),
+                                     static_cast<int>(std::floor(raw[i].y() / 0.5)),
+                                     static_cast<int>(std::floor(raw[i].z() / 0.5)));
+    if (seen.insert(key).second) reference.push_back(i);
+  }
+  ASSERT_GT(reference.size(), 10000u);
+  for (const int threads : {1, 2, 3}) {
+    EXPECT_EQ(RangeGatedVoxelIndices(raw, 0.5, 1.0, 40.0, threads), reference)
+        << threads << " threads";
+  }
+}
+
 TEST(Frontend, PreprocessUsesFineVoxelsForInitialScans) {
   std::mt19937 rng(24);
   LidarFrontendOptions options;
@@ -158,6 +259,11 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.loss_scale, d.loss_scale);
   EXPECT_EQ(o.convergence_translation, d.convergence_translation);
   EXPECT_EQ(o.convergence_rotation, d.convergence_rotation);
+  EXPECT_EQ(o.association, "knn");
+  EXPECT_EQ(o.association, d.association);
+  EXPECT_EQ(o.voxel_plane_max_thickness, d.voxel_plane_max_thickness);
+  EXPECT_EQ(o.threads, 1);
+  EXPECT_EQ(o.threads, d.threads);
 }
 
 std::string ErrorOf(const std::string& yaml) {
@@ -177,6 +283,8 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_NE(ErrorOf("min_neighbours: 30\n").find("max_neighbours"), std::string::npos);
   EXPECT_NE(ErrorOf("point_noise_sigma: 0\n").find("point_noise_sigma"), std::string::npos);
   EXPECT_NE(ErrorOf("loss: tukey\n").find("loss"), std::string::npos);
+  EXPECT_NE(ErrorOf("association: kdtree\n").find("association"), std::string::npos);
+  EXPECT_NE(ErrorOf("threads: 0\n").find("threads"), std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);
   EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("voxel_size: 0.3\n")).voxel_size, 0.3);
   EXPECT_THROW(LoadLidarFrontendOptions("/nonexistent/lidar.yaml"), std::runtime_error);

@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -47,15 +48,35 @@ std::vector<Vec3> SyntheticSweep(int n, uint32_t seed) {
   return pts;
 }
 
+// Arg 1: the map keeps per-voxel planes (moments on insertion, refit of the changed voxels).
 void BM_VoxelMapInsert(benchmark::State& state) {
   const auto pts = SyntheticSweep(25000, 1);
+  VoxelMap::Options o;
+  o.fit_planes = state.range(0) != 0;
   for (auto _ : state) {
-    VoxelMap map(VoxelMap::Options{});
+    VoxelMap map(o);
     benchmark::DoNotOptimize(map.Insert(pts));
   }
   state.SetItemsProcessed(state.iterations() * pts.size());
 }
-BENCHMARK(BM_VoxelMapInsert)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VoxelMapInsert)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// One association: Arg 0 the kNN plane (20 neighbours + PCA), Arg 1 the map's voxel plane.
+void BM_Associate(benchmark::State& state) {
+  LidarFrontendOptions options;
+  options.association = state.range(0) != 0 ? "voxel_plane" : "knn";
+  VoxelMap map(LidarFrontend::MapOptions(options));
+  for (uint32_t s = 0; s < 8; ++s) map.Insert(SyntheticSweep(25000, 10 + s));
+  const auto queries = SyntheticSweep(4096, 99);
+  PlaneAssociator associator(map, options);
+  PlaneAssociation a;
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(associator.Associate(Vec3::Zero(), queries[i++ & 4095], &a));
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Associate)->Arg(0)->Arg(1);
 
 void BM_VoxelMapKNearest(benchmark::State& state) {
   VoxelMap map(VoxelMap::Options{});
@@ -79,6 +100,56 @@ void BM_VoxelGridSubsample(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * sweep.size());
 }
 BENCHMARK(BM_VoxelGridSubsample)->Arg(2)->Arg(5)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+// A 128-beam × 1800-firing sweep (230 400 returns, the main job's size) in firing order from the
+// centre of a 100 × 60 × 10 m box, as the simulator's room: consecutive returns of a firing fall
+// in neighbouring voxels, as in a real sweep.
+std::vector<Vec3> BoxSweep() {
+  const Vec3 half(50.0, 30.0, 5.0);
+  std::vector<Vec3> pts;
+  pts.reserve(128 * 1800);
+  for (int f = 0; f < 1800; ++f) {
+    const double azimuth = 2.0 * M_PI * f / 1800;
+    for (int b = 0; b < 128; ++b) {
+      const double elevation = (-22.5 + 45.0 * b / 127) * M_PI / 180.0;
+      const Vec3 d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                   std::sin(elevation));
+      double r = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] != 0.0) r = std::min(r, half[a] / std::abs(d[a]));
+      }
+      pts.push_back(r * d + Vec3(0.0, 0.0, 0.3));
+    }
+  }
+  return pts;
+}
+
+// The preprocessing's one pass (range gate 1–100 m + first point per 0.5 m voxel) over the
+// 230 400 returns, with Arg threads, against the floor of any such pass: reading the points
+// once (BM_SweepBandwidthFloor).
+void BM_RangeGatedVoxelIndices(benchmark::State& state) {
+  const std::vector<Vec3> sweep = BoxSweep();
+  const int threads = static_cast<int>(state.range(0));
+  size_t kept = 0;
+  for (auto _ : state) {
+    kept = RangeGatedVoxelIndices(sweep, 0.5, 1.0, 100.0, threads).size();
+    benchmark::DoNotOptimize(kept);
+  }
+  state.SetItemsProcessed(state.iterations() * sweep.size());
+  state.counters["kept"] = static_cast<double>(kept);
+}
+BENCHMARK(BM_RangeGatedVoxelIndices)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+void BM_SweepBandwidthFloor(benchmark::State& state) {
+  const std::vector<Vec3> sweep = BoxSweep();
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (const Vec3& p : sweep) sum += p.squaredNorm();
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * sweep.size());
+}
+BENCHMARK(BM_SweepBandwidthFloor)->Unit(benchmark::kMicrosecond);
 
 PlaneAssociation SomeAssociation() {
   PlaneAssociation m;

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
+
+#include "ctlio/solvers/lio/frontend.h"
 
 namespace ctlio::lio {
 namespace {
@@ -178,6 +181,69 @@ TEST(VoxelMap, SearchAndInsertStayExactAfterRemoval) {
     const int n = map.KNearest(q, 10, &out, 1.0);
     ASSERT_EQ(n, std::min<int>(10, static_cast<int>(d2.size())));
     for (int i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(out[i].squared_distance, d2[i]);
+  }
+}
+
+// Every voxel's kept plane equals the PCA plane of the points it holds (FitPlane, two-pass) after
+// each batch of insertions (batches partly into voxels that already have points, partly into
+// full ones) and after removing far voxels; a map without fit_planes keeps none.
+TEST(VoxelMap, PlanesFollowTheirPoints) {
+  std::mt19937 rng(17);
+  VoxelMap::Options o = DefaultOptions();
+  o.fit_planes = true;
+  o.max_distance = 4.0;
+  VoxelMap map(o);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const auto check = [&](const char* when) {
+    int planes = 0;
+    map.ForEachVoxel([&](const VoxelKey&, const VoxelPoints& pts) {
+      const VoxelPlane* plane = map.PlaneOf(pts[0]);
+      ASSERT_NE(plane, nullptr) << when;
+      std::vector<VoxelMap::Neighbour> nb;
+      for (const Vec3& p : pts) nb.push_back({p, 0.0});
+      PlaneFit fit;
+      if (!FitPlane(nb, &fit)) {
+        EXPECT_EQ(plane->points, 0) << when;
+        return;
+      }
+      ++planes;
+      EXPECT_EQ(plane->points, static_cast<int32_t>(pts.size())) << when;
+      EXPECT_LT((plane->fit.centroid - fit.centroid).norm(), 1e-12) << when;
+      EXPECT_GT(std::abs(plane->fit.normal.dot(fit.normal)), 1.0 - 1e-9) << when;
+      // One-pass moments against the two-pass covariance, through the closed-form eigensolver
+      // (accurate to ~1e-8 relative): rounding, not a different plane.
+      EXPECT_NEAR(plane->fit.planarity_weight, fit.planarity_weight, 1e-6) << when;
+      EXPECT_NEAR(plane->fit.sigma3, fit.sigma3, 1e-6) << when;
+    });
+    EXPECT_GT(planes, 20) << when;
+  };
+  for (int batch = 0; batch < 4; ++batch) {
+    // Noisy planar patches (the z = 0.3·x plane) 3 m around the origin, plus blobs.
+    std::vector<Vec3> pts = RandomPoints(rng, 400, 3.0);
+    for (size_t i = 0; i < pts.size(); i += 2) pts[i].z() = 0.3 * pts[i].x() + noise(rng);
+    map.Insert(pts);
+    map.Insert(Vec3(0.5, 0.5, 0.15 + 0.01 * batch));  // the single-point path
+    check("after an insertion");
+  }
+  EXPECT_GT(map.RemoveFar(Vec3(2.0, 2.0, 0.0)), 0u);
+  check("after RemoveFar");
+  map.Insert(RandomPoints(rng, 400, 3.0));
+  check("after an insertion following RemoveFar");
+  VoxelMap plain(DefaultOptions());
+  plain.Insert(RandomPoints(rng, 100, 1.0));
+  EXPECT_EQ(plain.PlaneOf(Vec3(0.1, 0.1, 0.1)), nullptr);
+  EXPECT_EQ(map.PlaneOf(Vec3(100.0, 0.0, 0.0)), nullptr);  // no such voxel
+}
+
+// The floor-free voxel key equals std::floor on and one ulp beside voxel boundaries, both signs.
+TEST(VoxelMap, VoxelKeyIsTheFloor) {
+  for (int i = -40; i <= 40; ++i) {
+    for (const double a : {0.5 * i, std::nextafter(0.5 * i, -1e9), std::nextafter(0.5 * i, 1e9)}) {
+      const VoxelKey k = VoxelKeyOf(Vec3(a, -a, a + 0.25), 2.0);
+      EXPECT_EQ(k.x, static_cast<int32_t>(std::floor(a * 2.0))) << a;
+      EXPECT_EQ(k.y, static_cast<int32_t>(std::floor(-a * 2.0))) << a;
+      EXPECT_EQ(k.z, static_cast<int32_t>(std::floor((a + 0.25) * 2.0))) << a;
+    }
   }
 }
 

@@ -57,6 +57,36 @@ TEST(LioPipeline, SingerLioAndBaselineTrackShortSimulatedSequence) {
   }
 }
 
+// lidar_frontend.threads: the association and the range gate run in parallel chunks, merged in
+// order, so two threads give the same trajectory as one, bit for bit. The voxel-plane association
+// tracks the same sequence within the same bound.
+TEST(LioPipeline, FrontendThreadsAndVoxelPlanes) {
+  // Singer-LIO only: the baseline runs the same front end (ScanRegistration, PrepareScan).
+  for (const LioMethod m : {LioMethod::kSingerLio}) {
+    sim::SimulatedSource one_source(ShortSequence());
+    const lioapp::RunSummary one = lioapp::RunOdometry(one_source, Config(m));
+    OdometryConfig two_threads = Config(m);
+    two_threads.frontend.threads = 2;
+    sim::SimulatedSource two_source(ShortSequence());
+    const lioapp::RunSummary two = lioapp::RunOdometry(two_source, two_threads);
+    ASSERT_EQ(one.trajectory.size(), two.trajectory.size());
+    ASSERT_EQ(one.trajectory.size(), 10u);
+    for (size_t i = 0; i < one.trajectory.size(); ++i) {
+      EXPECT_EQ(one.trajectory[i].pose.Matrix(), two.trajectory[i].pose.Matrix())
+          << LioMethodName(m) << " scan " << i;
+      EXPECT_EQ(one.scans[i].associations, two.scans[i].associations);
+    }
+  }
+  OdometryConfig planes = Config(LioMethod::kSingerLio);
+  planes.frontend.association = "voxel_plane";
+  sim::SimulatedSource source(ShortSequence());
+  const lioapp::RunSummary run = lioapp::RunOdometry(source, planes);
+  ASSERT_TRUE(run.ate.has_value());
+  EXPECT_EQ(run.failed, 0) << run.first_failure;
+  EXPECT_LT(run.ate->rmse, 0.06);
+  for (size_t i = 1; i < run.scans.size(); ++i) EXPECT_GE(run.scans[i].associations, 50);
+}
+
 TEST(LioPipeline, BadInputThrowsWithReason) {
   auto odometry = MakeLioOdometry(Config(LioMethod::kSingerLio));
   ImuSample s;

@@ -1,10 +1,11 @@
 #include "ctlio/solvers/lio/frontend.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+
+#include "ctlio/solvers/lio/parallel_for.h"
 
 namespace ctlio::lio {
 
@@ -27,16 +28,23 @@ constexpr int64_t kKeyOffset = int64_t{1} << 20;
 constexpr int64_t kKeyRange = int64_t{1} << 21;
 constexpr uint64_t kEmpty = ~uint64_t{0};
 
+// ⌊a⌋ + kKeyOffset for kKeyOffset ≤ a < kKeyOffset (checked by the caller): truncation toward
+// zero, one down for a negative non-integer — exactly std::floor's value, without its rounding
+// mode dance on targets without SSE4.1's roundsd.
+inline uint64_t FloorPlusOffset(double a) {
+  const int64_t t = static_cast<int64_t>(a);
+  return static_cast<uint64_t>(t - (a < static_cast<double>(t) ? 1 : 0) + kKeyOffset);
+}
+
 inline bool PackedKey(const Vec3& p, double inverse_size, uint64_t* key) {
-  const double fx = std::floor(p.x() * inverse_size), fy = std::floor(p.y() * inverse_size),
-               fz = std::floor(p.z() * inverse_size);
-  const double lo = -static_cast<double>(kKeyOffset), hi = static_cast<double>(kKeyOffset - 1);
-  if (!(fx >= lo && fx <= hi && fy >= lo && fy <= hi && fz >= lo && fz <= hi)) return false;
-  const uint64_t x = static_cast<uint64_t>(static_cast<int64_t>(fx) + kKeyOffset);
-  const uint64_t y = static_cast<uint64_t>(static_cast<int64_t>(fy) + kKeyOffset);
-  const uint64_t z = static_cast<uint64_t>(static_cast<int64_t>(fz) + kKeyOffset);
+  const double ax = p.x() * inverse_size, ay = p.y() * inverse_size, az = p.z() * inverse_size;
+  // ⌊a⌋ ∈ [−2²⁰, 2²⁰ − 1] ⇔ a ∈ [−2²⁰, 2²⁰); false for NaN as well.
+  constexpr double lo = -static_cast<double>(kKeyOffset), hi = static_cast<double>(kKeyOffset);
+  if (!(ax >= lo && ax < hi && ay >= lo && ay < hi && az >= lo && az < hi)) return false;
   static_assert(3 * 21 < 64, "packed key must not collide with kEmpty");
-  *key = (x * static_cast<uint64_t>(kKeyRange) + y) * static_cast<uint64_t>(kKeyRange) + z;
+  *key = (FloorPlusOffset(ax) * static_cast<uint64_t>(kKeyRange) + FloorPlusOffset(ay)) *
+             static_cast<uint64_t>(kKeyRange) +
+         FloorPlusOffset(az);
   return true;
 }
 
@@ -53,11 +61,22 @@ class PackedKeySet {
     if (table_.empty()) {
       table_.assign(kInitialCapacity, kEmpty);
       mask_ = kInitialCapacity - 1;
+    } else if (8 * used_.size() < table_.size()) {
+      // Reset only the slots in use: a sweep's few ten thousand voxels, not the whole table
+      // (the memset of which was ~3% of AddScan's instructions).
+      for (const uint64_t slot : used_) table_[slot] = kEmpty;
     } else {
       std::fill(table_.begin(), table_.end(), kEmpty);
     }
+    used_.clear();
     size_ = 0;
     last_ = kEmpty;
+  }
+  bool Contains(uint64_t key) const {
+    for (uint64_t slot = MixVoxelHash(key) & mask_;; slot = (slot + 1) & mask_) {
+      if (table_[slot] == key) return true;
+      if (table_[slot] == kEmpty) return false;
+    }
   }
   // Inserts key; returns whether it was new.
   bool Insert(uint64_t key) {
@@ -70,6 +89,7 @@ class PackedKeySet {
       if (table_[slot] == key) return false;
       if (table_[slot] == kEmpty) {
         table_[slot] = key;
+        used_.push_back(slot);
         ++size_;
         return true;
       }
@@ -81,16 +101,19 @@ class PackedKeySet {
   void Grow() {
     spare_.assign(2 * table_.size(), kEmpty);
     const uint64_t mask = spare_.size() - 1;
+    used_.clear();
     for (const uint64_t key : table_) {
       if (key == kEmpty) continue;
       uint64_t slot = MixVoxelHash(key) & mask;
       while (spare_[slot] != kEmpty) slot = (slot + 1) & mask;
       spare_[slot] = key;
+      used_.push_back(slot);
     }
     table_.swap(spare_);
     mask_ = mask;
   }
   std::vector<uint64_t> table_, spare_;
+  std::vector<uint64_t> used_;  // the slots holding a key
   uint64_t mask_ = 0;
   size_t size_ = 0;
   uint64_t last_ = kEmpty;  // the key of the previous Insert
@@ -115,21 +138,58 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
   return out;
 }
 
-std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
-                                           double min_range, double max_range) {
-  if (!(voxel_size > 0.0)) throw std::invalid_argument("RangeGatedVoxelIndices: voxel_size <= 0");
-  std::vector<size_t> out;
-  if (points.empty()) return out;
-  thread_local PackedKeySet seen;
-  seen.Clear();
-  const double inverse_size = 1.0 / voxel_size;
-  const double min2 = min_range * min_range, max2 = max_range * max_range;
-  for (size_t i = 0; i < points.size(); ++i) {
+namespace {
+
+// The indices in [begin, end) of the points in the range band that are the first of their voxel
+// within [begin, end), in order; `seen` ends up holding those points' voxels.
+void FirstOfVoxelInBand(const std::vector<Vec3>& points, size_t begin, size_t end,
+                        double inverse_size, double min2, double max2, PackedKeySet* seen,
+                        std::vector<size_t>* out) {
+  seen->Clear();
+  for (size_t i = begin; i < end; ++i) {
     const double r2 = points[i].squaredNorm();
     if (!(r2 >= min2 && r2 <= max2)) continue;  // also drops non-finite points
     uint64_t key;
     if (!PackedKey(points[i], inverse_size, &key)) continue;
-    if (seen.Insert(key)) out.push_back(i);
+    if (seen->Insert(key)) out->push_back(i);
+  }
+}
+
+}  // namespace
+
+std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
+                                           double min_range, double max_range, int threads) {
+  if (!(voxel_size > 0.0)) throw std::invalid_argument("RangeGatedVoxelIndices: voxel_size <= 0");
+  if (points.empty()) return {};
+  const double inverse_size = 1.0 / voxel_size;
+  const double min2 = min_range * min_range, max2 = max_range * max_range;
+  // Reused across calls: fresh tables per sweep cost allocations and page faults.
+  thread_local std::vector<PackedKeySet> seen_buffers;
+  thread_local std::vector<std::vector<size_t>> kept_buffers;
+  // The calling thread's buffers, by reference: in the workers the names above would denote
+  // the workers' own (empty) thread_local instances.
+  std::vector<PackedKeySet>& seen = seen_buffers;
+  std::vector<std::vector<size_t>>& kept = kept_buffers;
+  const size_t chunks = std::clamp<size_t>(static_cast<size_t>(std::max(threads, 1)), 1,
+                                           std::max<size_t>(1, points.size() / 16384));
+  if (seen.size() < chunks) seen.resize(chunks);
+  if (kept.size() < chunks) kept.resize(chunks);
+  // Each chunk keeps the first point of each voxel within the chunk; a point of chunk c is the
+  // first of its voxel in the whole sweep iff no earlier chunk has that voxel. Same indices as
+  // one pass, for any number of chunks.
+  ParallelFor(static_cast<int>(chunks), points.size(), [&](size_t c, size_t begin, size_t end) {
+    kept[c].clear();
+    FirstOfVoxelInBand(points, begin, end, inverse_size, min2, max2, &seen[c], &kept[c]);
+  });
+  std::vector<size_t> out(kept[0]);
+  for (size_t c = 1; c < chunks; ++c) {
+    for (const size_t i : kept[c]) {
+      uint64_t key;
+      PackedKey(points[i], inverse_size, &key);
+      bool earlier = false;
+      for (size_t e = 0; e < c && !earlier; ++e) earlier = seen[e].Contains(key);
+      if (!earlier) out.push_back(i);
+    }
   }
   return out;
 }
@@ -150,35 +210,33 @@ bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plan
     cov.noalias() += d * d.transpose();
   }
   cov /= static_cast<double>(n);
-  // Closed-form 3×3 eigen-decomposition (several times faster than the iterative QL solver;
-  // the plane normal's eigenvalue is well separated for the planar patches that pass the gate).
-  Eigen::SelfAdjointEigenSolver<Mat3> es;
-  es.computeDirect(cov);
-  if (es.info() != Eigen::Success) return false;
-  // Eigenvalues ascending: λ0 ≤ λ1 ≤ λ2, σ1 = √λ2 ≥ σ2 = √λ1 ≥ σ3 = √λ0.
-  const Vec3 lambda = es.eigenvalues().cwiseMax(0.0);
-  plane->sigma1 = std::sqrt(lambda[2]);
-  plane->sigma2 = std::sqrt(lambda[1]);
-  plane->sigma3 = std::sqrt(lambda[0]);
-  if (!(plane->sigma1 > 0.0)) return false;
-  const double a2d = (plane->sigma2 - plane->sigma3) / plane->sigma1;
-  plane->planarity_weight = a2d * a2d;
-  plane->centroid = mean;
-  plane->normal = es.eigenvectors().col(0).normalized();
-  return true;
+  return FitPlaneFromMoments(mean, cov, plane);
 }
 
 PlaneAssociator::PlaneAssociator(const VoxelMap& map, const LidarFrontendOptions& options)
-    : map_(map), options_(options) {
+    : map_(map), options_(options), voxel_planes_(options.association == "voxel_plane") {
+  if (voxel_planes_ && !map.options().fit_planes) {
+    throw std::invalid_argument(
+        "PlaneAssociator: association voxel_plane needs a map that keeps its planes "
+        "(VoxelMap::Options::fit_planes, set by LidarFrontend::MapOptions)");
+  }
   neighbours_.reserve(options.max_neighbours);
 }
 
 bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
                                 PlaneAssociation* association) {
-  const int found = map_.KNearest(p_map, options_.max_neighbours, &neighbours_);
-  if (found < options_.min_neighbours) return false;
-  PlaneFit plane;
-  if (!FitPlane(neighbours_, &plane)) return false;
+  PlaneFit knn_plane;
+  const PlaneFit* fit = &knn_plane;
+  const VoxelPlane* voxel = voxel_planes_ ? map_.PlaneOf(p_map) : nullptr;
+  if (voxel != nullptr && voxel->points >= options_.min_neighbours &&
+      voxel->fit.sigma3 <= options_.voxel_plane_max_thickness) {
+    fit = &voxel->fit;  // a hash lookup instead of the kNN search and the PCA
+  } else {
+    const int found = map_.KNearest(p_map, options_.max_neighbours, &neighbours_);
+    if (found < options_.min_neighbours) return false;
+    if (!FitPlane(neighbours_, &knn_plane)) return false;
+  }
+  const PlaneFit& plane = *fit;
   const double distance = std::abs(plane.normal.dot(p_map - plane.centroid));
   if (!(distance <= options_.max_plane_distance)) return false;
   association->point_robot = q_robot;
@@ -194,6 +252,7 @@ VoxelMap::Options LidarFrontend::MapOptions(const LidarFrontendOptions& options)
   m.max_points_per_voxel = options.max_points_per_voxel;
   m.min_point_distance = options.min_point_distance;
   m.max_distance = options.max_map_distance;
+  m.fit_planes = options.association == "voxel_plane";
   return m;
 }
 

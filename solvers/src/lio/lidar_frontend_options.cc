@@ -28,6 +28,10 @@ void LidarFrontendOptions::Validate() const {
   require(min_neighbours >= 3, "min_neighbours must be >= 3 (a plane needs three points)");
   require(max_neighbours >= min_neighbours, "max_neighbours must be >= min_neighbours");
   require(max_plane_distance > 0.0, "max_plane_distance must be positive");
+  require(association == "knn" || association == "voxel_plane",
+          "association must be knn or voxel_plane");
+  require(voxel_plane_max_thickness >= 0.0, "voxel_plane_max_thickness must be >= 0");
+  require(threads >= 1, "threads must be >= 1");
   require(max_iterations >= 1 && solver_iterations >= 1, "iteration counts must be >= 1");
   // Upper bounds: with zero convergence thresholds the solver runs to these on every scan, so an
   // unbounded value is a run that never ends.
@@ -64,6 +68,9 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"max_neighbours", SetFromYaml(&o.max_neighbours)},
       {"min_neighbours", SetFromYaml(&o.min_neighbours)},
       {"max_plane_distance", SetFromYaml(&o.max_plane_distance)},
+      {"association", SetFromYaml(&o.association)},
+      {"voxel_plane_max_thickness", SetFromYaml(&o.voxel_plane_max_thickness)},
+      {"threads", SetFromYaml(&o.threads)},
       {"max_iterations", SetFromYaml(&o.max_iterations)},
       {"solver_iterations", SetFromYaml(&o.solver_iterations)},
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},

@@ -284,7 +284,7 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   // survivors in the robot frame (idempotent up to the extrinsic's shift of the voxel grid).
   const std::vector<size_t> kept =
       RangeGatedVoxelIndices(scan.points, frontend_.NextVoxelSize(), config_.frontend.min_range,
-                             config_.frontend.max_range);
+                             config_.frontend.max_range, config_.frontend.threads);
   std::vector<TimedPoint> raw;
   raw.reserve(kept.size());
   for (const size_t i : kept) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "ctlio/solvers/lio/frontend.h"
+#include "ctlio/solvers/lio/parallel_for.h"
 
 namespace ctlio::lio {
 
@@ -29,7 +30,16 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
                                                SlidingWindow* window) const {
   using Clock = std::chrono::steady_clock;
   RegistrationSummary summary;
-  PlaneAssociator associator(map, options_);
+  // One associator (neighbour buffer) per thread; the keypoints are placed in the map first
+  // (the term's interpolation is not thread-safe), associated in parallel chunks, and their
+  // residuals added in keypoint order: the window is the same for any number of threads.
+  const int threads = options_.threads;
+  std::vector<PlaneAssociator> associators(static_cast<size_t>(threads),
+                                           PlaneAssociator(map, options_));
+  const size_t n = term->num_keypoints();
+  std::vector<Vec3> q(n), p_map(n);
+  std::vector<PlaneAssociation> associations(n);
+  std::vector<uint8_t> associated(n);
   std::vector<ceres::ResidualBlockId> blocks;
   SE3 last_pose = term->NewestPose();
   for (int round = 0; round < options_.max_iterations; ++round) {
@@ -41,11 +51,16 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
     // One loss per round, shared by its residuals; once a residual uses it the window owns it
     // (ref-counted by Ceres, deleted with the last such residual).
     std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
-    for (size_t i = 0; i < term->num_keypoints(); ++i) {
-      Vec3 q, p_map;
-      term->Locate(i, &q, &p_map);
-      PlaneAssociation a;
-      if (!associator.Associate(q, p_map, &a)) continue;
+    for (size_t i = 0; i < n; ++i) term->Locate(i, &q[i], &p_map[i]);
+    ParallelFor(threads, n, [&](size_t chunk, size_t begin, size_t end) {
+      PlaneAssociator& associator = associators[chunk];
+      for (size_t i = begin; i < end; ++i) {
+        associated[i] = associator.Associate(q[i], p_map[i], &associations[i]) ? 1 : 0;
+      }
+    });
+    for (size_t i = 0; i < n; ++i) {
+      if (!associated[i]) continue;
+      PlaneAssociation& a = associations[i];
       a.weight /= options_.point_noise_sigma;
       blocks.push_back(term->AddResidual(i, a, loss.get(), window));
     }

@@ -55,6 +55,11 @@ int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
     slot.voxel = static_cast<int32_t>(keys_.size());
     keys_.push_back(key);
     counts_.push_back(0);
+    if (options_.fit_planes) {
+      moments_.emplace_back();
+      planes_.emplace_back();
+      changed_.push_back(0);
+    }
     if ((keys_.size() - 1) >> kChunkBits >= pool_.size()) {
       pool_.emplace_back(new Vec3[(size_t{1} << kChunkBits) * stride_]);
     }
@@ -76,7 +81,9 @@ void VoxelMap::Rehash(size_t min_slots) {
 
 bool VoxelMap::Insert(const Vec3& p) {
   if (!p.allFinite()) return false;
-  return InsertInto(FindOrAdd(VoxelKeyOf(p, inverse_voxel_size_)), p);
+  const bool kept = InsertInto(FindOrAdd(VoxelKeyOf(p, inverse_voxel_size_)), p);
+  RefitChangedPlanes();
+  return kept;
 }
 
 bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
@@ -88,7 +95,52 @@ bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
   }
   points[count++] = p;
   ++num_points_;
+  if (options_.fit_planes) {
+    const VoxelKey& k = keys_[voxel];
+    const Vec3 d = p - Vec3(k.x, k.y, k.z) * options_.voxel_size;
+    Moments& m = moments_[voxel];
+    m.sum += d;
+    m.sq[0] += d.x() * d.x();
+    m.sq[1] += d.x() * d.y();
+    m.sq[2] += d.x() * d.z();
+    m.sq[3] += d.y() * d.y();
+    m.sq[4] += d.y() * d.z();
+    m.sq[5] += d.z() * d.z();
+    if (!changed_[voxel]) {
+      changed_[voxel] = 1;
+      changed_voxels_.push_back(voxel);
+    }
+  }
   return true;
+}
+
+void VoxelMap::RefitChangedPlanes() {
+  for (const int32_t voxel : changed_voxels_) {
+    changed_[voxel] = 0;
+    const int32_t n = counts_[voxel];
+    VoxelPlane& plane = planes_[voxel];
+    plane.points = 0;
+    if (n < 3) continue;
+    // Mean and population covariance from the moments: E[d] and E[d·dᵀ] − E[d]·E[d]ᵀ, d relative
+    // to the corner (|d| ≤ √3 voxel sizes, so the subtraction loses nothing that matters).
+    const Moments& m = moments_[voxel];
+    const double inv_n = 1.0 / n;
+    const Vec3 mean_d = m.sum * inv_n;
+    Mat3 cov;
+    cov << m.sq[0], m.sq[1], m.sq[2], m.sq[1], m.sq[3], m.sq[4], m.sq[2], m.sq[4], m.sq[5];
+    cov = cov * inv_n - mean_d * mean_d.transpose();
+    const VoxelKey& k = keys_[voxel];
+    if (FitPlaneFromMoments(Vec3(k.x, k.y, k.z) * options_.voxel_size + mean_d, cov, &plane.fit)) {
+      plane.points = n;
+    }
+  }
+  changed_voxels_.clear();
+}
+
+const VoxelPlane* VoxelMap::PlaneOf(const Vec3& p) const {
+  if (!options_.fit_planes) return nullptr;
+  const int32_t voxel = Find(VoxelKeyOf(p, inverse_voxel_size_));
+  return voxel == kNoVoxel ? nullptr : &planes_[voxel];
 }
 
 size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
@@ -107,6 +159,7 @@ size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
     }
     kept += InsertInto(last_voxel, p) ? 1 : 0;
   }
+  RefitChangedPlanes();
   return kept;
 }
 
@@ -126,6 +179,10 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
       counts_[kept] = counts_[i];
       std::copy_n(BlockOf(static_cast<int32_t>(i)), counts_[i],
                   BlockOf(static_cast<int32_t>(kept)));
+      if (options_.fit_planes) {  // no refit pending: every Insert ends with one
+        moments_[kept] = moments_[i];
+        planes_[kept] = planes_[i];
+      }
     }
     ++kept;
   }
@@ -133,6 +190,11 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
   if (removed == 0) return 0;
   keys_.resize(kept);
   counts_.resize(kept);
+  if (options_.fit_planes) {
+    moments_.resize(kept);
+    planes_.resize(kept);
+    changed_.resize(kept);
+  }
   pool_.resize((kept + (size_t{1} << kChunkBits) - 1) >> kChunkBits);
   Rehash(2 * kept + 1);
   return removed;
@@ -187,6 +249,10 @@ void VoxelMap::Clear() {
   keys_.clear();
   counts_.clear();
   pool_.clear();
+  moments_.clear();
+  planes_.clear();
+  changed_.clear();
+  changed_voxels_.clear();
   num_points_ = 0;
 }
 

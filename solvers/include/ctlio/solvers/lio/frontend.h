@@ -8,6 +8,7 @@
 #include "ctlio/factors/lidar/point_to_plane.h"
 #include "ctlio/manifolds/types.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
+#include "ctlio/solvers/lio/plane_fit.h"
 #include "ctlio/solvers/lio/voxel_map.h"
 
 namespace ctlio::lio {
@@ -31,18 +32,10 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
 
 // Indices of the points (any frame) with min_range ≤ |p| ≤ max_range that are the first of their
 // voxel: the range gate and VoxelGridSubsample in one pass over a raw sweep, without copying it.
+// With threads > 1 the sweep is split into that many chunks processed in parallel and merged in
+// order (same indices).
 std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
-                                           double min_range, double max_range);
-
-// The plane through a point's neighbours.
-struct PlaneFit {
-  Vec3 centroid = Vec3::Zero();
-  Vec3 normal = Vec3::UnitZ();  // unit, eigenvector of the smallest covariance eigenvalue
-  // σ1 ≥ σ2 ≥ σ3: square roots of the covariance eigenvalues.
-  double sigma1 = 0.0, sigma2 = 0.0, sigma3 = 0.0;
-  // ((σ2 − σ3)/σ1)² (SPEC §4): ≈1 for a clean plane, ≈0 for a line or an isotropic blob.
-  double planarity_weight = 0.0;
-};
+                                           double min_range, double max_range, int threads = 1);
 
 // PCA of the neighbours; false for fewer than three points or a degenerate (zero-spread) set.
 bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane);
@@ -53,15 +46,19 @@ class PlaneAssociator {
  public:
   PlaneAssociator(const VoxelMap& map, const LidarFrontendOptions& options);
 
-  // For q (robot frame) observed at p_map = T_mr q: ≥ min_neighbours of ≤ max_neighbours nearest
-  // map points (±1 voxel), a PCA plane through their centroid (less noisy than the nearest point
-  // alone) and |nᵀ(p_map − centroid)| ≤ max_plane_distance. Fills *association (weight = the
-  // planarity weight) and returns true on success.
+  // For q (robot frame) observed at p_map = T_mr q: a PCA plane and |nᵀ(p_map − centroid)| ≤
+  // max_plane_distance. association "knn": the plane of ≥ min_neighbours of ≤ max_neighbours
+  // nearest map points (±1 voxel), through their centroid (less noisy than the nearest point
+  // alone); "voxel_plane": the plane kept by the map for p_map's voxel when it holds ≥
+  // min_neighbours points and is at most voxel_plane_max_thickness thick, else the kNN plane. Fills
+  // *association (weight = the planarity weight) and returns true on success. Reads the map only:
+  // one associator per thread.
   bool Associate(const Vec3& q_robot, const Vec3& p_map, PlaneAssociation* association);
 
  private:
   const VoxelMap& map_;
   LidarFrontendOptions options_;
+  bool voxel_planes_;
   std::vector<VoxelMap::Neighbour> neighbours_;
 };
 

@@ -41,6 +41,18 @@ struct LidarFrontendOptions {
   int max_neighbours = 20;
   int min_neighbours = 10;
   double max_plane_distance = 1.0;
+  // "knn": the plane of the nearest map points, fitted per query; "voxel_plane": the plane the
+  // map keeps per voxel (moments updated on insertion, as in iG-LIO / VoxelMap), a hash lookup,
+  // with the kNN plane where the voxel holds fewer than min_neighbours points.
+  std::string association = "knn";
+  // voxel_plane only: a voxel's plane is used when its thickness σ3 (the smallest standard
+  // deviation of its points) is at most this, else the kNN plane (a voxel across an edge or a
+  // corner is no plane, while the nearest points on one face are).
+  double voxel_plane_max_thickness = 0.05;  // m
+
+  // Threads of the front end (association of the keypoints, range gate + subsampling of the raw
+  // sweep); results equal one thread's. Independent of the solver's window.threads.
+  int threads = 1;
 
   // Registration: re-association rounds, solver iterations per round, robust loss.
   int max_iterations = 10;

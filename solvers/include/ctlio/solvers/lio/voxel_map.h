@@ -11,6 +11,13 @@
 // without a transient second pool in the peak memory). A lookup is a hash and a few adjacent
 // slots, and a voxel's points are one contiguous block, instead of a node chain and a separate
 // heap block per voxel.
+//
+// Per-voxel planes (Options::fit_planes, as in iG-LIO and VoxelMap): each voxel also keeps the
+// sums Σd and Σd·dᵀ of its points (d relative to the voxel's corner, so the sums stay well
+// conditioned anywhere in the map) and the PCA plane of those moments. An insertion updates the
+// sums and marks the voxel; the planes of the marked voxels are refitted once at the end of the
+// insertion (a full voxel, the common case in a mapped area, never changes), so queries are
+// const and a voxel's plane is a hash lookup.
 #pragma once
 
 #include <cmath>
@@ -20,6 +27,7 @@
 #include <vector>
 
 #include "ctlio/manifolds/types.h"
+#include "ctlio/solvers/lio/plane_fit.h"
 
 namespace ctlio::lio {
 
@@ -28,10 +36,16 @@ struct VoxelKey {
   bool operator==(const VoxelKey& o) const { return x == o.x && y == o.y && z == o.z; }
 };
 
+// ⌊a⌋ for |a| < 2³¹: truncation toward zero, one down for a negative non-integer — std::floor's
+// value without its rounding-mode sequence (no SSE4.1 roundsd in a generic x86-64 build).
+inline int32_t FloorToInt(double a) {
+  const int32_t t = static_cast<int32_t>(a);
+  return t - (a < static_cast<double>(t) ? 1 : 0);
+}
+
 inline VoxelKey VoxelKeyOf(const Vec3& p, double inverse_voxel_size) {
-  return {static_cast<int32_t>(std::floor(p.x() * inverse_voxel_size)),
-          static_cast<int32_t>(std::floor(p.y() * inverse_voxel_size)),
-          static_cast<int32_t>(std::floor(p.z() * inverse_voxel_size))};
+  return {FloorToInt(p.x() * inverse_voxel_size), FloorToInt(p.y() * inverse_voxel_size),
+          FloorToInt(p.z() * inverse_voxel_size)};
 }
 
 // splitmix64's finaliser: spreads packed voxel coordinates over the slots of the
@@ -56,6 +70,13 @@ struct VoxelPoints {
   const Vec3& operator[](size_t i) const { return data[i]; }
 };
 
+// The plane of one voxel's points; `points` is how many it was fitted to (0: no plane, i.e.
+// fewer than three points or a degenerate spread).
+struct VoxelPlane {
+  PlaneFit fit;
+  int32_t points = 0;
+};
+
 class VoxelMap {
  public:
   struct Options {
@@ -63,6 +84,7 @@ class VoxelMap {
     int max_points_per_voxel = 20;
     double min_point_distance = 0.1;
     double max_distance = 400.0;
+    bool fit_planes = false;  // keep each voxel's moments and plane (PlaneOf)
   };
 
   struct Neighbour {
@@ -87,6 +109,10 @@ class VoxelMap {
   // that keeps the vector does not allocate). Returns their number.
   int KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
                double max_distance = std::numeric_limits<double>::infinity()) const;
+
+  // The plane of the voxel containing p, or nullptr when p's voxel is empty or the map keeps no
+  // planes (Options::fit_planes false).
+  const VoxelPlane* PlaneOf(const Vec3& p) const;
 
   size_t num_points() const { return num_points_; }
   size_t num_voxels() const { return keys_.size(); }
@@ -121,6 +147,15 @@ class VoxelMap {
   void Rehash(size_t min_slots);
   // Insert's body once the voxel of p is known.
   bool InsertInto(int32_t voxel, const Vec3& p);
+  // Refits the planes of the voxels whose points changed since the last call.
+  void RefitChangedPlanes();
+
+  // Σd and the upper triangle of Σd·dᵀ (xx, xy, xz, yy, yz, zz) of a voxel's points, d = p − the
+  // voxel's corner.
+  struct Moments {
+    Vec3 sum = Vec3::Zero();
+    double sq[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  };
 
   Options options_;
   double inverse_voxel_size_;
@@ -130,6 +165,11 @@ class VoxelMap {
   std::vector<VoxelKey> keys_;                 // per voxel
   std::vector<int32_t> counts_;                // per voxel
   std::vector<std::unique_ptr<Vec3[]>> pool_;  // chunks of 2^kChunkBits · stride_ points
+  // With fit_planes only, per voxel:
+  std::vector<Moments> moments_;
+  std::vector<VoxelPlane> planes_;
+  std::vector<uint8_t> changed_;         // points added since the last refit
+  std::vector<int32_t> changed_voxels_;  // the voxels with changed_ set
   size_t num_points_ = 0;
 };
 
