@@ -164,12 +164,7 @@ TEST(ImuMeasurement, ZeroResidualOnAcceleratingTrajectoryFromPhysics) {
 // and near-identity knots, with random ϖ, ϖ̇, biases and C_mi.
 TEST(ImuMeasurement, JacobiansMatchNumeric) {
   std::mt19937 rng(4);
-  PoseManifold pose;
-  RotationManifold rotation;
-  const std::vector<const ceres::Manifold*> gyro_manifolds = {&pose,   nullptr, nullptr, &pose,
-                                                              nullptr, nullptr, nullptr, nullptr};
-  std::vector<const ceres::Manifold*> accel_manifolds = gyro_manifolds;
-  accel_manifolds.push_back(&rotation);
+  const testing::ImuManifolds manifolds;
   Mat3 A = Mat3::Random();
   const Mat3 cov = 1e-3 * (A * A.transpose() + Mat3::Identity());
   for (int trial = 0; trial < 6; ++trial) {
@@ -178,11 +173,11 @@ TEST(ImuMeasurement, JacobiansMatchNumeric) {
     const Vec3 meas = testing::RandomVec6(rng, 5.0).head<3>();
     for (const SingerModel<6>& model : {Wnoj(), Singer()}) {
       const ImuGyroMeasurement gyro(model, t_k, t_k1, tau, meas, cov);
-      EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, gyro_manifolds, blocks.Gyro(), 1e-6))
+      EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, manifolds.gyro, blocks.Gyro(), 1e-6))
           << "gyro trial " << trial;
       for (const AccelModel m : {AccelModel::kBodyCentric, AccelModel::kSpecificForce}) {
         const ImuAccelMeasurement accel(model, t_k, t_k1, tau, meas, cov, 9.81, m);
-        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, accel_manifolds, blocks.Accel(), 1e-6))
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, manifolds.accel, blocks.Accel(), 1e-6))
             << "accel trial " << trial << " model " << static_cast<int>(m);
       }
     }

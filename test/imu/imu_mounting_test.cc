@@ -149,12 +149,7 @@ TEST(ImuMounting, DefaultMountingIsTheRobotFrame) {
 // large-rotation (near π) and near-identity knots, both models, WNOJ and Singer.
 TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {
   std::mt19937 rng(14);
-  PoseManifold pose;
-  RotationManifold rotation;
-  const std::vector<const ceres::Manifold*> gyro_manifolds = {&pose,   nullptr, nullptr, &pose,
-                                                              nullptr, nullptr, nullptr, nullptr};
-  std::vector<const ceres::Manifold*> accel_manifolds = gyro_manifolds;
-  accel_manifolds.push_back(&rotation);
+  const testing::ImuManifolds manifolds;
   const Mat3 A = Mat3::Random();
   const Mat3 cov = 1e-3 * (A * A.transpose() + Mat3::Identity());
   for (int trial = 0; trial < 6; ++trial) {
@@ -165,11 +160,11 @@ TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {
     const Vec3 meas = testing::RandomVec6(rng, 5.0).head<3>();
     for (const SingerModel<6>& model : {Wnoj(), Singer()}) {
       const ImuGyroMeasurement gyro(model, t_k, t_k1, tau, meas, cov, mounting);
-      EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, gyro_manifolds, blocks.Gyro(), 1e-6))
+      EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, manifolds.gyro, blocks.Gyro(), 1e-6))
           << "gyro trial " << trial;
       for (const AccelModel m : {AccelModel::kBodyCentric, AccelModel::kSpecificForce}) {
         const ImuAccelMeasurement accel(model, t_k, t_k1, tau, meas, cov, 9.81, m, mounting);
-        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, accel_manifolds, blocks.Accel(), 1e-6))
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, manifolds.accel, blocks.Accel(), 1e-6))
             << "accel trial " << trial << " model " << static_cast<int>(m);
       }
     }
@@ -181,12 +176,7 @@ TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {
 // (α = 1e-6 over 0.1 s) and the interpolation time at a knot (s → 0).
 TEST(ImuMounting, JacobiansMatchNumericAtSingularMountings) {
   std::mt19937 rng(15);
-  PoseManifold pose;
-  RotationManifold rotation;
-  const std::vector<const ceres::Manifold*> gyro_manifolds = {&pose,   nullptr, nullptr, &pose,
-                                                              nullptr, nullptr, nullptr, nullptr};
-  std::vector<const ceres::Manifold*> accel_manifolds = gyro_manifolds;
-  accel_manifolds.push_back(&rotation);
+  const testing::ImuManifolds manifolds;
   const Mat3 cov = 1e-3 * Mat3::Identity();
   const Vec3 axis = Vec3(0.4, -0.7, 0.59).normalized();
   const SingerModel<6> tiny_alpha(Vec6::Constant(100.0), Vec6::Constant(1e-6));
@@ -202,11 +192,11 @@ TEST(ImuMounting, JacobiansMatchNumericAtSingularMountings) {
       const Vec3 meas = testing::RandomVec6(rng, 5.0).head<3>();
       for (const SingerModel<6>& model : {Singer(), tiny_alpha}) {
         const ImuGyroMeasurement gyro(model, t_k, t_k1, tau, meas, cov, mounting);
-        EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, gyro_manifolds, blocks.Gyro(), 1e-6))
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, manifolds.gyro, blocks.Gyro(), 1e-6))
             << "gyro angle " << angle << " trial " << trial;
         const ImuAccelMeasurement accel(model, t_k, t_k1, tau, meas, cov, 9.81,
                                         AccelModel::kSpecificForce, mounting);
-        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, accel_manifolds, blocks.Accel(), 1e-6))
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, manifolds.accel, blocks.Accel(), 1e-6))
             << "accel angle " << angle << " trial " << trial;
       }
     }

@@ -26,6 +26,20 @@ inline gp::SingerModel<6> Singer() {
   return gp::SingerModel<6>(qc, alpha);
 }
 
+// The manifolds of the factors' parameter blocks, in Blocks' order: two knots (pose on SE(3),
+// velocity, acceleration), two bias blocks, and for the accelerometer the gravity rotation C_mi.
+struct ImuManifolds {
+  PoseManifold pose;
+  RotationManifold rotation;
+  std::vector<const ceres::Manifold*> gyro = {&pose,   nullptr, nullptr, &pose,
+                                              nullptr, nullptr, nullptr, nullptr};
+  std::vector<const ceres::Manifold*> accel = {&pose,   nullptr, nullptr, &pose,    nullptr,
+                                               nullptr, nullptr, nullptr, &rotation};
+  ImuManifolds() = default;
+  ImuManifolds(const ImuManifolds&) = delete;  // the vectors point into this object
+  ImuManifolds& operator=(const ImuManifolds&) = delete;
+};
+
 struct Blocks {
   double pose_k[7], vel_k[6], acc_k[6], pose_k1[7], vel_k1[6], acc_k1[6], b_k[6], b_k1[6], q_mi[4];
   Blocks(const gp::KnotState& k, const gp::KnotState& k1, const Vec6& bk, const Vec6& bk1,

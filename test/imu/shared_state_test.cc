@@ -72,12 +72,7 @@ double Difference(const Evaluation& a, const Evaluation& b) {
 
 TEST(ImuSharedState, PreparedSharedStateGivesTheFactorsOwnResultsAndMatchesNumeric) {
   std::mt19937 rng(31);
-  PoseManifold pose;
-  RotationManifold rotation;
-  const std::vector<const ceres::Manifold*> gyro_manifolds = {&pose,   nullptr, nullptr, &pose,
-                                                              nullptr, nullptr, nullptr, nullptr};
-  std::vector<const ceres::Manifold*> accel_manifolds = gyro_manifolds;
-  accel_manifolds.push_back(&rotation);
+  const testing::ImuManifolds manifolds;
   const Mat3 A = Mat3::Random();
   const Mat3 cov = 1e-3 * (A * A.transpose() + Mat3::Identity());
   for (int trial = 0; trial < 6; ++trial) {
@@ -113,10 +108,10 @@ TEST(ImuSharedState, PreparedSharedStateGivesTheFactorsOwnResultsAndMatchesNumer
           // Numeric differentiation perturbs the knots: those evaluations interpolate on their
           // own, the unperturbed one reads the prepared state.
           if (m == AccelModel::kBodyCentric) {
-            EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, gyro_manifolds, blocks.Gyro(), 1e-6))
+            EXPECT_TRUE(testing::JacobiansMatchNumeric(gyro, manifolds.gyro, blocks.Gyro(), 1e-6))
                 << "gyro trial " << trial;
           }
-          EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, accel_manifolds, blocks.Accel(), 1e-6))
+          EXPECT_TRUE(testing::JacobiansMatchNumeric(accel, manifolds.accel, blocks.Accel(), 1e-6))
               << "accel trial " << trial << " model " << static_cast<int>(m);
         }
       }

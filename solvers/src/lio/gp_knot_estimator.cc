@@ -151,13 +151,13 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
     const auto state =
         std::make_shared<gp::SharedStateInterpolation>(model_, prev.t, k.t, tau, knots);
     window->shared_interpolations().Add(state);
-    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov, mounting), nullptr,
-                             gyro_states);
+    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov, mounting),
+                             nullptr, gyro_states);
     ++result->imu_residuals;
     if (config_.method == LioMethod::kSingerLio) {
-      window->AddResidualBlock(
-          new imu::ImuAccelMeasurement(state, s.accel, accel_cov, config_.gravity, accel_model, mounting),
-          accel_loss.get(), accel_states);
+      window->AddResidualBlock(new imu::ImuAccelMeasurement(state, s.accel, accel_cov,
+                                                            config_.gravity, accel_model, mounting),
+                               accel_loss.get(), accel_states);
       accel_loss_used = accel_loss != nullptr;
       ++result->imu_residuals;
     }

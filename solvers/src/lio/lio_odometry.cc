@@ -234,13 +234,11 @@ void LioOdometry::ReportPoseCovariance(ScanResult* result) {
   if (!covariance.Compute(blocks, &window_.problem())) return;
   Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
   if (!covariance.GetCovarianceBlockInTangentSpace(pose, pose, block.data())) return;
-  Mat6 sigma = block;
-  if (estimator_->PoseBlockIsInverse()) {
-    // Block T_rm ← Exp(δ)·T_rm, so T_mr ← T_mr·Exp(−δ) = Exp(−Ad(T_mr)·δ)·T_mr.
-    const Mat6 ad = result->T_mr.Adjoint();
-    sigma = ad * sigma * ad.transpose();
-  }
-  result->pose_covariance = sigma;
+  // The block's tangent δ_state = A·δ_body (T_mr ← T_mr·Exp(δ_body)), and T_mr·Exp(δ_body) =
+  // Exp(Ad(T_mr)·δ_body)·T_mr: ε = Ad(T_mr)·A⁻¹·δ_state (the GP knots' T_rm: A = −I; the
+  // baseline's T_wb: A = Ad(T_wb), so ε = δ_state).
+  const Mat6 M = result->T_mr.Adjoint() * estimator_->NewestPoseTangentFromBody().inverse();
+  result->pose_covariance = M * Mat6(block) * M.transpose();
   result->has_pose_covariance = true;
 }
 

@@ -146,9 +146,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     const std::string key = kv.first.as<std::string>();
     const YAML::Node& v = kv.second;
     const std::string section = where + key;
-    if (top == nullptr &&
-        (key == "method" || key == "extrinsic" || key == "input" || key == "per_method" ||
-         key == "imus")) {
+    if (top == nullptr && (key == "method" || key == "extrinsic" || key == "input" ||
+                           key == "per_method" || key == "imus")) {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": '" + section +
                                "' cannot be set per method");
     }

@@ -67,10 +67,6 @@ class Estimator {
 
   // How an IMU gap is bridged (for the scan's status message).
   virtual std::string ImuGapRecovery() const = 0;
-  // The window block of the newest pose, and whether it holds T_rm (the GP knots) rather than
-  // T_mr (the baseline's T_wb); both perturb on the left, T ← Exp(δ)·T (PoseManifold).
-  virtual StateId NewestPoseKey() const = 0;
-  virtual bool PoseBlockIsInverse() const = 0;
 };
 
 // The estimator of config.method. `imu` is the odometry's buffer (read only).

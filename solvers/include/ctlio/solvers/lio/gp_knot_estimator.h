@@ -44,8 +44,6 @@ class GpKnotEstimator final : public Estimator {
   double previous_time() const override { return knots_[knots_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
-  StateId NewestPoseKey() const override { return knots_.back().keys.pose; }
-  bool PoseBlockIsInverse() const override { return true; }
 
  private:
   // A knot's blocks live in the window (which owns the storage).

@@ -46,8 +46,6 @@ class NavStateEstimator final : public Estimator {
   double previous_time() const override { return states_[states_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override;
-  StateId NewestPoseKey() const override { return states_.back().keys.pose; }
-  bool PoseBlockIsInverse() const override { return false; }
 
   // A state's blocks live in the window.
   struct State {

@@ -141,9 +141,10 @@ struct OdometryConfig {
 // Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
 // `lidar_frontend`, `degeneracy`, `input` and `per_method`. Missing keys keep their defaults;
 // unknown keys and bad values throw std::runtime_error naming file and line. `per_method` maps a
-// method name (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`, `window`,
-// `lidar_frontend` whose keys replace the base values for that method only (same keys, same
-// checks; `method`, `extrinsic` and `input` — properties of the data — cannot be set per method):
+// method name (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`,
+// `window`, `lidar_frontend` whose keys replace the base values for that method only (same keys,
+// same checks; `method`, `extrinsic` and `input` — properties of the data — cannot be set per
+// method):
 //   lidar_frontend: {max_iterations: 3}
 //   per_method:
 //     imu_input: {lidar_frontend: {max_iterations: 5}}
