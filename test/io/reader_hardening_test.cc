@@ -117,7 +117,9 @@ TEST(ReaderHardening, ZeroQuaternionInTheCtlioYamlIsAnError) {
   const fs::path d = CtlioFixture("zero_q");
   auto lines = Lines(d / "ctlio_sim.yaml");
   for (auto& l : lines) {
-    if (l.find("quaternion_xyzw") != std::string::npos) l = "  quaternion_xyzw: [0, 0, 0, 0]";
+    // Keep the line's indentation: the key sits at several depths (extrinsic, imus list).
+    const size_t k = l.find("quaternion_xyzw");
+    if (k != std::string::npos) l = l.substr(0, k) + "quaternion_xyzw: [0, 0, 0, 0]";
   }
   WriteLines(d / "ctlio_sim.yaml", lines);
   ExpectError([&] { SimFolderReader r(d.string()); }, {"ctlio_sim.yaml", "quaternion norm 0"});
