@@ -11,17 +11,6 @@
 
 namespace ctlio::lio {
 
-void DegeneracyOptions::Validate() const {
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(std::string("OdometryConfig: ") + what);
-  };
-  require(translation_threshold >= 0 && translation_threshold < 3,
-          "degeneracy.translation_threshold must be in [0, 3)");
-  require(rotation_threshold >= 0 && rotation_threshold < 3,
-          "degeneracy.rotation_threshold must be in [0, 3)");
-  require(remap_information > 0, "degeneracy.remap_information must be positive");
-}
-
 std::string DegeneracyReport::DirectionString() const {
   if (directions.empty()) return "-";
   const Vec6& u = directions.front();
