@@ -10,7 +10,7 @@ errors). Writes <method_dir>/odometry.png and, for several methods, <out_dir>/co
   * top view (x-y) and side view (x-z) in metres: ground truth, the estimate at the densest rate
     written, the scan poses as dots;
   * position error [cm] and rotation error [deg] over time;
-  * per-scan run time [ms] over time, coloured by scan status; degenerate, IMU-gap and failed
+  * per-scan CPU time [ms] of the scan thread over time, coloured by scan status; degenerate, IMU-gap and failed
     scans marked, gaps in the scan sequence shaded.
 Exit code 3 if matplotlib is missing (the caller then writes its SVG fallback). CTLIO_PLOT_DPI
 sets the resolution (default 90).
@@ -56,9 +56,25 @@ def read_evaluation(path):
 
 
 def read_scans(path):
+    """(t, status, CPU ms of the scan thread) per scan; the wall-clock `ms` column of logs written
+    before `cpu_ms` existed. Columns are found by the header's names."""
     scans = []
     if not os.path.exists(path):
         return scans
+    t_col, status_col, ms_col = 0, 1, 8
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#"):
+                names = line[1:].split()
+                if "cpu_ms" in names:
+                    ms_col = names.index("cpu_ms")
+                elif "ms" in names:
+                    ms_col = names.index("ms")
+                continue
+            p = line.split()
+            if len(p) > ms_col:
+                scans.append((float(p[t_col]), p[status_col], float(p[ms_col])))
+    return scans
     with open(path) as f:
         for line in f:
             if line.startswith("#"):
@@ -190,7 +206,7 @@ def draw_timing(ax, runs, single):
                                label="gap between scans" if first_gap and k == 0 else None)
                     first_gap = False
     ax.set_xlabel("time since the first scan [s]")
-    ax.set_ylabel("run time per scan [ms]")
+    ax.set_ylabel("CPU time per scan [ms]")
     ax.set_title("per-scan time and status" if single else "per-scan time")
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
