@@ -6,6 +6,9 @@
 # The corpus grows in BUILD_DIR/corpus/<target> across runs; a crash or sanitizer report stops
 # the script with the reproducer in BUILD_DIR/artifacts/ (rerun: BUILD_DIR/fuzz/fuzz_<target>
 # <file>).
+#   CTLIO_FUZZ_TESTS="io_dataset_test io_pcd_hardening_test"   also builds these gtest targets in
+# the same instrumented tree and runs them (ASan + UBSan) before fuzzing: CI does this for the
+# reader tests, which costs a few test files more than the fuzz build, not a second build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -16,18 +19,36 @@ targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder new
 bash scripts/install_deps.sh
 
 start=$(date +%s)
+tests=${CTLIO_FUZZ_TESTS:-}
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
-  -DCTLIO_FUZZ=ON -DCTLIO_BUILD_TESTS=OFF -DCTLIO_BUILD_BENCHMARKS=OFF \
+  -DCTLIO_FUZZ=ON -DCTLIO_BUILD_TESTS="$([ -n "$tests" ] && echo ON || echo OFF)" \
+  -DCTLIO_BUILD_BENCHMARKS=OFF \
   ${CMAKE_CXX_COMPILER_LAUNCHER:+-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER} >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target fuzz_all
+# shellcheck disable=SC2086  # the test list is a word list
+cmake --build "$build_dir" -j"$(nproc)" --target fuzz_all $tests
 echo "fuzz: build done in $(( $(date +%s) - start )) s"
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+# The listed gtest executables (<part>_<name>, in build/test/<part>/) under the sanitizers, each
+# from its own folder as ctest runs them.
+for t in $tests; do
+  exe=$(find "$build_dir/test" -type f -name "$t" -perm -u+x | head -n 1)
+  if [ -z "$exe" ]; then
+    echo "fuzz: test target $t was not built"
+    exit 1
+  fi
+  echo "fuzz: $t under ASan + UBSan"
+  if ! (cd "$(dirname "$exe")" && "./$t" --gtest_brief=1); then
+    echo "fuzz: $t FAILED under the sanitizers"
+    exit 1
+  fi
+done
 
 corpus="$build_dir/corpus"
 artifacts="$build_dir/artifacts"
 mkdir -p "$corpus" "$artifacts"
 "$build_dir/fuzz/fuzz_make_seeds" "$corpus" "$PWD"
-export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
-export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 for t in $targets; do
   mkdir -p "$corpus/$t"
   # Inputs that once crashed a target stay in its corpus (fuzz/regressions/<target>_*).
