@@ -59,6 +59,20 @@ TEST(ExtrinsicError, NominalIsOffByExactlyTheRequestedAmounts) {
             0.0);
 }
 
+TEST(ExtrinsicError, SigmaCoverageComparesEachAxisWithItsSigma) {
+  const SE3 truth(so3::Exp(Vec3(0.1, 0.0, 0.0)), Vec3(0.1, 0.0, 0.0));
+  const SE3 estimate = SE3::Exp((Vec6() << 0.01, 0, 0, 0, 0.002, 0).finished()) * truth;
+  Vec6 sigma = Vec6::Constant(0.001);
+  SigmaCoverage c = CoveredBySigma(estimate, truth, sigma);
+  EXPECT_FALSE(c.translation);  // 1 cm error, 3σ = 3 mm
+  EXPECT_TRUE(c.rotation);      // 2 mrad within 3 mrad
+  sigma[0] = 0.004;
+  sigma[4] = 0.0005;
+  c = CoveredBySigma(estimate, truth, sigma);
+  EXPECT_TRUE(c.translation);
+  EXPECT_FALSE(c.rotation);
+}
+
 TEST(ExtrinsicError, SourceHandsOutTheNominalAndKeepsTheTruth) {
   SimConfig c = ExperimentConfig(Regime::kMedium, 0);
   c.duration_s = 0.3;

@@ -111,4 +111,12 @@ ExtrinsicErrorSize MeasureExtrinsicError(const SE3& estimate, const SE3& truth) 
   return s;
 }
 
+SigmaCoverage CoveredBySigma(const SE3& estimate, const SE3& truth, const Vec6& sigma, double k) {
+  const Vec6 d = (truth * estimate.Inverse()).Log();
+  SigmaCoverage c;
+  c.translation = (d.head<3>().cwiseAbs().array() <= k * sigma.head<3>().array()).all();
+  c.rotation = (d.tail<3>().cwiseAbs().array() <= k * sigma.tail<3>().array()).all();
+  return c;
+}
+
 }  // namespace ctlio::sim

@@ -44,4 +44,12 @@ struct ExtrinsicErrorSize {
 };
 ExtrinsicErrorSize MeasureExtrinsicError(const SE3& estimate, const SE3& truth);
 
+// Whether the error δ = Log(T_true·T_est⁻¹) (the left perturbation [ρ; φ] that a marginal
+// covariance of T_est describes) lies within k·σ on every translation / rotation axis.
+struct SigmaCoverage {
+  bool translation = false, rotation = false;
+};
+SigmaCoverage CoveredBySigma(const SE3& estimate, const SE3& truth, const Vec6& sigma,
+                             double k = 3.0);
+
 }  // namespace ctlio::sim
