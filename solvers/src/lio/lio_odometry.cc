@@ -14,6 +14,7 @@
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/input_checks.h"
+#include "ctlio/solvers/lio/state_keys.h"
 
 namespace ctlio::lio {
 
@@ -223,6 +224,24 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
   if (config_.pose_covariance) ReportPoseCovariance(result);
+  if (result->calibration.has_extrinsic) ReportExtrinsicCovariance(result);
+}
+
+void LioOdometry::ReportExtrinsicCovariance(ScanResult* result) {
+  double* extrinsic = window_.State(kExtrinsicKey);
+  // Dense SVD (the window has < 100 tangent parameters) with the null space dropped: C_mi, refined
+  // with the extrinsic, has a null direction (the yaw about gravity), which the QR of
+  // ReportPoseCovariance would refuse; the pseudo-inverse gives the extrinsic's marginal σ.
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.null_space_rank = -1;
+  ceres::Covariance covariance(options);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{extrinsic, extrinsic}};
+  if (!covariance.Compute(blocks, &window_.problem())) return;
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
+  if (!covariance.GetCovarianceBlockInTangentSpace(extrinsic, extrinsic, block.data())) return;
+  // PoseManifold's left perturbation [ρ; φ] of T_rl.
+  result->calibration.extrinsic_sigma = block.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
 void LioOdometry::ReportPoseCovariance(ScanResult* result) {
@@ -283,11 +302,16 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   const std::vector<size_t> kept =
       RangeGatedVoxelIndices(scan.points, frontend_.NextVoxelSize(), config_.frontend.min_range,
                              config_.frontend.max_range, config_.frontend.threads);
+  // The configured extrinsic, or with online calibration its current estimate (the lidar
+  // residuals recover the lidar-frame points through prepared.T_robot_lidar).
+  prepared.T_robot_lidar =
+      window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
+  const SE3& T_robot_lidar = prepared.T_robot_lidar;
   std::vector<TimedPoint> raw;
   raw.reserve(kept.size());
   for (const size_t i : kept) {
     TimedPoint p;
-    p.point = config_.T_imu_lidar * scan.points[i];
+    p.point = T_robot_lidar * scan.points[i];
     // Points are registered between the previous knot and this one; a time outside by less than
     // input.scan_time_tolerance (clock jitter of the driver; the rest was dropped and counted in
     // DropPointsOutsideInterval) is clamped onto the interval rather than extrapolated.

@@ -7,6 +7,9 @@
 // Several IMUs (OdometryConfig::imus): every sample of every IMU is a measurement of the state at
 // its own time with its IMU's mounting (lever arm and rotation, imu_mounting.h) and noise, and
 // each IMU has its own bias blocks (KnotKeys::Bias) with their own random walk.
+// Online calibration (OdometryConfig::calibration.estimate_extrinsic): the extrinsic T_rl is a
+// static state (kExtrinsicKey) with a prior on the configured value, read by every lidar
+// residual (ContinuousPointToPlaneExtrinsic); the map points are placed with its estimate.
 #pragma once
 
 #include <deque>
@@ -56,6 +59,7 @@ class GpKnotEstimator final : public Estimator {
     std::vector<double*> bias;  // per IMU; empty for lidar_only
   };
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
+  bool estimates_extrinsic() const { return config_.calibration.estimate_extrinsic; }
   int num_imus() const { return uses_imu() ? config_.num_imus() : 0; }
   // `bias`: the initial value of every IMU's bias, per IMU.
   Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw,
@@ -72,6 +76,7 @@ class GpKnotEstimator final : public Estimator {
   gp::SingerModel<6> model_;
   std::vector<imu::ImuMounting> mountings_;  // per IMU
   std::deque<Knot> knots_;                   // oldest first
+  double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
 };
 

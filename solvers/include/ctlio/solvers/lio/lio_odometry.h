@@ -89,6 +89,9 @@ class LioOdometry {
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   void ReportPoseCovariance(ScanResult* result);
+  // With calibration.estimate_extrinsic: the marginal σ of T_imu_lidar (ceres::Covariance of the
+  // window) into result->calibration.extrinsic_sigma.
+  void ReportExtrinsicCovariance(ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
