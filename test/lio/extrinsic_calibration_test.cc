@@ -9,7 +9,6 @@
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "ctlio/solvers/lio/state_keys.h"
-#include "lio/run_odometry.h"
 
 namespace ctlio::lio {
 namespace {
