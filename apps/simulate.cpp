@@ -28,6 +28,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
@@ -75,6 +76,10 @@ DEFINE_double(bias_walk_accel, 0.0, "Accelerometer bias random walk [m/s²/√s]
 DEFINE_double(bias_walk_gyro, 0.0, "Gyro bias random walk [rad/s/√s]");
 DEFINE_int32(pillars, 0, "Interior 1 m × 1 m pillars placed at random (seeded) in the room");
 DEFINE_bool(ground_truth, true, "Write the ground-truth trajectory");
+DEFINE_string(extrinsic_error, "",
+              "Write a NOMINAL lidar->IMU extrinsic off the true one by <angle>deg[@ax:ay:az],"
+              "<distance>m[@dx:dy:dz] (axis/direction drawn per --index when omitted; the truth "
+              "goes to true_imu_from_lidar), e.g. 3deg,0.10m (apps/sim extrinsic_error.h)");
 DEFINE_bool(newer_college_extrinsic, false,
             "Use the Newer College lidar→IMU extrinsic instead of identity (always used with "
             "--layout=newer_college, which cannot carry another)");
@@ -166,6 +171,16 @@ int main(int argc, char** argv) {
     config.extra_imus = sim::ParseImuSpecs(FLAGS_imus, I);
     // The Newer College layout carries no extrinsic and is read with the published one.
     if (FLAGS_layout == "newer_college") config.imu_from_lidar = io::NewerCollegeImuFromLidar();
+    const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_extrinsic_error);
+    if (!extrinsic_error.IsZero()) {
+      if (FLAGS_layout != "ctlio") {
+        throw std::runtime_error(
+            "--extrinsic_error needs --layout ctlio (the only layout that "
+            "records the true extrinsic next to the nominal one)");
+      }
+      config.nominal_imu_from_lidar =
+          sim::NominalExtrinsic(config.imu_from_lidar, extrinsic_error, FLAGS_seed, FLAGS_index);
+    }
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
     if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
     std::mt19937_64 rng(FLAGS_seed + 17);

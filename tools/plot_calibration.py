@@ -43,6 +43,26 @@ def read_truth(folder):
     return truth
 
 
+def read_extrinsic_truth(folder):
+    """{column: true value} of the extrinsic's deviation from the start (calibration.yaml's comment
+    "# Extrinsic truth from the start: rho = [..] m, phi = [..] deg", simulator runs only)."""
+    path = os.path.join(folder, "calibration.yaml")
+    if not os.path.exists(path):
+        return {}
+    num = r"([-+0-9.eE]+)"
+    vec = r"\[" + num + r", " + num + r", " + num + r"\]"
+    with open(path) as f:
+        for line in f:
+            m = re.match(r"# Extrinsic truth from the start: rho = " + vec + r" m, phi = " + vec,
+                         line)
+            if m:
+                v = [float(x) for x in m.groups()]
+                keys = [f"extrinsic_rho_{a}_m" for a in "xyz"] + \
+                       [f"extrinsic_phi_{a}_deg" for a in "xyz"]
+                return dict(zip(keys, v))
+    return {}
+
+
 def plot(folder):
     cols = read_columns(os.path.join(folder, "calibration.csv"))
     if "t_s" not in cols or not cols["t_s"]:
@@ -56,10 +76,20 @@ def plot(folder):
         if m:
             series.append((f"IMU {m.group(1)} time offset [ms]", h,
                            f"time_offset_{m.group(1)}_sigma_s", 1e3, int(m.group(1))))
-    # (Further calibration columns, e.g. the extrinsic's, are added to `series` here.)
+    # The extrinsic: its deviation from the starting value, [rho; phi] of T = Exp([rho; phi]) T_start.
+    for a in "xyz":
+        key = f"extrinsic_rho_{a}_m"
+        if key in cols:
+            series.append((f"extrinsic rho_{a} [cm]", key, f"extrinsic_rho_{a}_sigma_m", 1e2, key))
+    for a in "xyz":
+        key = f"extrinsic_phi_{a}_deg"
+        if key in cols:
+            series.append((f"extrinsic phi_{a} [deg]", key, f"extrinsic_phi_{a}_sigma_deg", 1.0,
+                           key))
     if not series:
         return
     truth = read_truth(folder)
+    truth.update(read_extrinsic_truth(folder))
     fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
     for ax, (label, key, sigma_key, scale, imu) in zip(axes[:, 0], series):
         est = [scale * v for v in cols[key]]

@@ -13,6 +13,7 @@
 #include "ctlio/factors/imu/imu_gyro_time_offset.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/factors/priors/euclidean_prior.h"
+#include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
 #include "ctlio/solvers/lio/continuous_lidar_term.h"
@@ -97,6 +98,10 @@ void GpKnotEstimator::Report(ScanResult* result) const {
   result->bias = k.bias.empty() ? Vec6::Zero() : Vec6(Eigen::Map<const Vec6>(k.bias[0]));
   result->imu_biases.clear();
   for (const double* b : k.bias) result->imu_biases.push_back(Eigen::Map<const Vec6>(b));
+  if (extrinsic_ != nullptr) {
+    result->calibration.has_extrinsic = true;
+    result->calibration.T_imu_lidar = PoseManifold::Pose(extrinsic_);
+  }
 }
 
 void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
@@ -106,7 +111,25 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
   // initial bias prior (zero mean, config variances), so the marginal priors carry them on.
   if (config_.method == LioMethod::kSingerLio) {
     window->AddRotationState(kGravityKey, C_mi);
-    if (!config_.estimate_gravity) window->SetStateConstant(kGravityKey, true);
+    // With the extrinsic estimated, C_mi is refined too: the map frame is fixed by the first
+    // scan's points, placed with the prior extrinsic, so a rotation error of the prior tilts the
+    // map against the gravity C_mi was initialised with (in the robot frame); held, that tilt
+    // would pull the extrinsic back to its prior through the accelerometer.
+    if (!config_.estimate_gravity && !estimates_extrinsic()) {
+      window->SetStateConstant(kGravityKey, true);
+    }
+  }
+  if (estimates_extrinsic()) {
+    // T_rl: a static state with the Gaussian prior of the config (mean T_imu_lidar, σ per
+    // rotation and translation axis, left perturbation as PoseManifold: [ρ; φ]).
+    extrinsic_ = window->AddPoseState(kExtrinsicKey, config_.T_imu_lidar);
+    const CalibrationOptions& c = config_.calibration;
+    Vec6 sigma;
+    sigma << Vec3::Constant(c.extrinsic_prior_sigma_m),
+        Vec3::Constant(c.extrinsic_prior_sigma_deg * M_PI / 180.0);
+    window->AddResidualBlock(
+        new PosePrior(config_.T_imu_lidar, sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
+        nullptr, {kExtrinsicKey});
   }
   knots_.push_back(AddKnot(scan.t_end, SE3(), Vec6::Zero(), Vec6::Zero(),
                            std::vector<Vec6>(num_imus(), Vec6::Zero()), window));
@@ -260,6 +283,10 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
                                                           SlidingWindow* window) const {
   const Knot& prev = knots_[knots_.size() - 2];
   const Knot& k = knots_.back();
+  if (estimates_extrinsic()) {
+    return std::make_unique<ContinuousLidarTerm>(model_, prev.t, k.t, prev.keys, k.keys,
+                                                 scan.keypoints, scan.T_robot_lidar, window);
+  }
   return std::make_unique<ContinuousLidarTerm>(model_, prev.t, k.t, prev.keys, k.keys,
                                                scan.keypoints, window);
 }
@@ -277,6 +304,11 @@ std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
   std::vector<Vec6> twist(nodes - 1);
   for (int j = 0; j < nodes; ++j) grid[j] = PoseAt(prev, k, prev.t + j * step);
   for (int j = 0; j + 1 < nodes; ++j) twist[j] = (grid[j + 1] * grid[j].Inverse()).Log();
+  // With calibration, the points were moved into the robot frame with the extrinsic of the
+  // preparation; they enter the map with the current estimate: T_mr(τ)·T_rl·T_prep⁻¹·q.
+  const bool recalibrate = extrinsic_ != nullptr;
+  const SE3 correction =
+      recalibrate ? PoseManifold::Pose(extrinsic_) * scan.T_robot_lidar.Inverse() : SE3();
   std::vector<Vec3> map_points;
   map_points.reserve(scan.points.size());
   double last_tau = -1.0;
@@ -286,6 +318,7 @@ std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
       const double u = std::clamp((p.time - prev.t) / step, 0.0, nodes - 1.0);
       const int j = std::min(static_cast<int>(u), nodes - 2);
       T_mr_tau = SE3::Exp((u - j) * twist[j]) * grid[j];
+      if (recalibrate) T_mr_tau = T_mr_tau * correction;
       last_tau = p.time;
     }
     map_points.push_back(T_mr_tau * p.point);

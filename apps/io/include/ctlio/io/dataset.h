@@ -71,6 +71,9 @@ class DataSource {
   virtual SE3 ImuFromLidar() const = 0;
   // Where ImuFromLidar comes from, for the log ("dataset files", "bag /tf_static", "preset ...").
   virtual std::string ExtrinsicOrigin() const { return "the dataset (" + Name() + ")"; }
+  // The true T_imu_lidar where the source knows it (simulator), which may differ from the
+  // nominal ImuFromLidar (calibration experiments).
+  virtual std::optional<SE3> TrueImuFromLidar() const { return std::nullopt; }
   // Ground truth T_world_lidar, time-sorted, if the source has it.
   virtual std::optional<std::vector<StampedPose>> GroundTruth() const { return std::nullopt; }
   // Gravity magnitude the IMU data assume, if the source knows it (simulator: exact value).

@@ -13,6 +13,9 @@
 // the interval that holds t + δ̄_j for the estimate δ̄_j when its knot is added (each sample once:
 // the stamps taken follow on from the previous interval's). Configured but not estimated: the
 // fixed-time factors at t + δ_j. Neither: the estimator without offsets, bit for bit.
+// Online calibration (OdometryConfig::calibration.estimate_extrinsic): the extrinsic T_rl is a
+// static state (kExtrinsicKey) with a prior on the configured value, read by every lidar
+// residual (ContinuousPointToPlaneExtrinsic); the map points are placed with its estimate.
 #pragma once
 
 #include <deque>
@@ -62,6 +65,7 @@ class GpKnotEstimator final : public Estimator {
     std::vector<double*> bias;  // per IMU; empty for lidar_only
   };
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
+  bool estimates_extrinsic() const { return config_.calibration.estimate_extrinsic; }
   int num_imus() const { return uses_imu() ? config_.num_imus() : 0; }
   // `bias`: the initial value of every IMU's bias, per IMU.
   Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw,
@@ -81,6 +85,7 @@ class GpKnotEstimator final : public Estimator {
   gp::SingerModel<6> model_;
   std::vector<imu::ImuMounting> mountings_;  // per IMU
   std::deque<Knot> knots_;                   // oldest first
+  double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement

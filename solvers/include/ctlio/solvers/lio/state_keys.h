@@ -13,6 +13,9 @@ namespace ctlio::lio {
 
 // C_mi, the gravity-aligned frame i → map frame m (a RotationManifold block, SPEC §3).
 inline constexpr StateId kGravityKey = -1;
+// T_rl = T_imu_lidar, lidar → robot frame (a PoseManifold block), with calibration.
+// estimate_extrinsic only: a static state like C_mi, never marginalised (calibration_options.h).
+inline constexpr StateId kExtrinsicKey = -2;
 
 // Static calibration states (calibration_options.h), like C_mi kept in the window and in the
 // marginal prior when knots leave. IMU j's clock offset δ_j [s] (1-D): −16 + j (j < 5); the ids
