@@ -44,10 +44,12 @@
 
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
+#include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "lio/calibration_output.h"
 #include "lio/experiment_results.h"
 #include "lio/run_odometry.h"
 
@@ -77,6 +79,20 @@ DEFINE_bool(nominal, true, "With --imu_outage: also run the scenario without out
 DEFINE_string(imus, "",
               "Further IMUs in every sequence: ';'-separated key=value lists (rate, xyz, rpy, "
               "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage; imu_specs.h)");
+DEFINE_double(imu_stamp_offset, 0.0,
+              "IMU 0's samples of the motion at t are stamped t - this [s] (the simulated clock "
+              "offset; other IMUs: stamp_offset= in --imus)");
+DEFINE_bool(estimate_time_offset, false,
+            "Estimate each IMU's clock offset online (calibration.estimate_time_offset); the "
+            "final estimates, sigmas and errors per run go to OUT/calibration.csv");
+DEFINE_string(time_offset, "",
+              "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
+              "mean when estimated, else applied as given");
+DEFINE_string(extrinsic_error, "",
+              "Hand every run a NOMINAL lidar->IMU extrinsic off the simulated one by "
+              "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
+              "drawn per sequence when omitted; apps/sim extrinsic_error.h); with it or with "
+              "calibration.estimate_extrinsic, OUT/extrinsic.csv has every run's extrinsic error");
 DEFINE_bool(pose_covariance, false,
             "Pose covariance per scan and its NEES against the truth (OUT/nees.csv)");
 DEFINE_string(merge, "",
@@ -169,6 +185,42 @@ void WriteBarSvg(const std::string& path,
   io::CloseChecked(f, path);
 }
 
+// OUT/extrinsic.csv: per run with a perturbed nominal or an estimated extrinsic, the starting
+// and final extrinsic errors against the truth (rotation [deg], translation [cm]), the final
+// marginal σ per axis ([ρ] cm, [φ] deg) and whether the error lies within 3σ on every axis, and the
+// ATE (sim/extrinsic_error.h).
+void WriteExtrinsicErrors(const std::string& out, const std::vector<Job>& jobs) {
+  std::ostringstream csv;
+  csv << "regime,sequence,method,ate_m,initial_error_deg,initial_error_cm,error_deg,error_cm,"
+         "sigma_x_cm,sigma_y_cm,sigma_z_cm,sigma_rx_deg,sigma_ry_deg,sigma_rz_deg,"
+         "rotation_within_3sigma,translation_within_3sigma\n";
+  bool any = false;
+  for (const Job& j : jobs) {
+    if (!j.done || !j.run.true_extrinsic) continue;
+    const lioapp::RunSummary& run = j.run;
+    const bool perturbed =
+        (run.true_extrinsic->Matrix() - run.initial_extrinsic.Matrix()).norm() > 0.0;
+    if (!perturbed && !run.extrinsic_estimated) continue;
+    any = true;
+    const sim::ExtrinsicErrorSize e0 =
+        sim::MeasureExtrinsicError(run.initial_extrinsic, *run.true_extrinsic);
+    const sim::ExtrinsicErrorSize e1 =
+        sim::MeasureExtrinsicError(run.final_extrinsic, *run.true_extrinsic);
+    const Vec6& s = run.final_extrinsic_sigma;
+    csv << j.regime << ',' << j.index << ',' << j.method << ',' << (run.ate ? run.ate->rmse : NAN)
+        << ',' << e0.rotation_deg << ',' << 100 * e0.translation_m << ',' << e1.rotation_deg << ','
+        << 100 * e1.translation_m;
+    if (run.extrinsic_estimated) {
+      const sim::SigmaCoverage c = sim::CoveredBySigma(run.final_extrinsic, *run.true_extrinsic, s);
+      for (int i = 0; i < 6; ++i) csv << ',' << s[i] * (i < 3 ? 100.0 : 180.0 / M_PI);
+      csv << ',' << c.rotation << ',' << c.translation << "\n";
+    } else {
+      csv << ",,,,,,,,\n";
+    }
+  }
+  if (any) io::WriteTextFile(out + "/extrinsic.csv", csv.str());
+}
+
 // The settings that must be equal for runs to be pooled, one "key value" per line.
 std::string SettingsText(const std::string& config_path, const std::string& preset,
                          const std::string& world, const ctlio::sim::SimConfig& shared) {
@@ -180,6 +232,7 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
     << FLAGS_failure_ate << "\n";
   // Only when set, so that single-IMU settings (and merges with earlier jobs) stay as they were.
   if (!FLAGS_imus.empty()) s << "imus " << FLAGS_imus << "\n";
+  if (!FLAGS_extrinsic_error.empty()) s << "extrinsic_error " << FLAGS_extrinsic_error << "\n";
   return s.str();
 }
 
@@ -345,6 +398,44 @@ std::optional<T> Given(const char* flag, const T& value) {
   return ctlio::apps::Given(!FLAGS_sim_preset.empty(), flag, value);
 }
 
+// OUT/calibration.csv (one line per run and IMU): the online calibration's final clock offset,
+// its marginal σ, the simulated truth, the error and |error| ≤ 3σ, and the run's ATE; and the
+// first and last σ (whether it shrinks: observability).
+void WriteCalibration(const std::string& out, const std::vector<Job>& jobs) {
+  std::ofstream f = io::OpenForWriting(out + "/calibration.csv");
+  f << "regime,sequence,method,imu,time_offset_s,sigma_s,first_sigma_s,true_s,error_s,"
+       "within_3sigma,ate_rmse_m\n"
+    << std::setprecision(9);
+  for (const Job& j : jobs) {
+    if (!j.done) continue;
+    const lio::ScanResult* last = lioapp::LastCalibration(j.run);
+    if (last == nullptr) continue;
+    const lio::ScanResult* first = nullptr;
+    for (const auto& r : j.run.scans) {
+      if (!r.calibration.time_offset_sigma_s.empty()) {
+        first = &r;
+        break;
+      }
+    }
+    const auto& c = last->calibration;
+    for (size_t i = 0; i < c.time_offset_s.size(); ++i) {
+      const double sigma = i < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[i] : NAN;
+      const double first_sigma =
+          first != nullptr && i < first->calibration.time_offset_sigma_s.size()
+              ? first->calibration.time_offset_sigma_s[i]
+              : NAN;
+      const bool known = i < j.run.true_time_offsets.size() && j.run.true_time_offsets[i];
+      const double truth = known ? *j.run.true_time_offsets[i] : 0.0;
+      const double error = c.time_offset_s[i] - truth;
+      f << j.regime << ',' << j.index << ',' << j.method << ',' << i << ',' << c.time_offset_s[i]
+        << ',' << sigma << ',' << first_sigma << ',' << truth << ',' << error << ','
+        << (std::abs(error) <= 3 * sigma ? 1 : 0) << ',' << (j.run.ate ? j.run.ate->rmse : NAN)
+        << "\n";
+    }
+  }
+  io::CloseChecked(f, out + "/calibration.csv");
+}
+
 int main(int argc, char** argv) {
   gflags::SetUsageMessage("Table II: Singer-LIO vs the IMU-as-input baseline in simulation");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
@@ -378,6 +469,7 @@ int main(int argc, char** argv) {
     for (const auto& r : regimes) sim::ParseRegime(r);
     const sim::SimConfig shared = sim::PresetConfig(preset, 0, sim::kExperimentSeed, given);
     for (const auto& m : methods) lio::ParseLioMethod(m);
+    const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_extrinsic_error);
     // Scenarios: (name, outage length); the nominal one first.
     std::vector<std::pair<std::string, double>> scenarios;
     if (FLAGS_imu_outage.empty() || FLAGS_nominal) scenarios.push_back({"none", 0.0});
@@ -431,10 +523,23 @@ int main(int argc, char** argv) {
           if (job.outage_s > 0) {
             c.imu.outages.push_back({0.5 * (c.duration_s - job.outage_s), job.outage_s});
           }
+          c.imu.stamp_offset_s = FLAGS_imu_stamp_offset;
           c.extra_imus = sim::ParseImuSpecs(FLAGS_imus, c.imu);
+          if (!extrinsic_error.IsZero()) {
+            c.nominal_imu_from_lidar = sim::NominalExtrinsic(c.imu_from_lidar, extrinsic_error,
+                                                             sim::kExperimentSeed, job.index);
+          }
           sim::SimulatedSource source(c, "sim:" + job.regime + "/" + std::to_string(job.index));
           lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(job.method));
           if (FLAGS_pose_covariance) config.pose_covariance = true;
+          if (FLAGS_estimate_time_offset) config.calibration.estimate_time_offset = true;
+          if (!FLAGS_time_offset.empty()) {
+            config.calibration.time_offset_s.clear();
+            std::stringstream list(FLAGS_time_offset);
+            for (std::string d; std::getline(list, d, ',');) {
+              config.calibration.time_offset_s.push_back(std::stod(d));
+            }
+          }
           job.run = lioapp::RunOdometry(source, config, {}, FLAGS_failure_ate);
           job.done = true;
         } catch (const std::exception& e) {
@@ -488,6 +593,8 @@ int main(int argc, char** argv) {
     io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
     lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
     if (FLAGS_pose_covariance) WriteNees(FLAGS_out, jobs);
+    if (FLAGS_estimate_time_offset) WriteCalibration(FLAGS_out, jobs);
+    WriteExtrinsicErrors(FLAGS_out, jobs);
     const double el =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::ostringstream provenance;

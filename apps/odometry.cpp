@@ -46,11 +46,13 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/yaml_io.h"
+#include "lio/calibration_output.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
@@ -103,6 +105,20 @@ DEFINE_string(sim_imus, "",
 DEFINE_bool(pose_covariance, false,
             "Covariance of every scan's pose (window.pose_covariance) and, with ground truth, its "
             "NEES in evaluation.txt");
+DEFINE_double(sim_imu_stamp_offset, 0.0,
+              "--format sim: IMU 0's samples of the motion at t are stamped t - this [s] (the "
+              "clock offset the online calibration should find; other IMUs: stamp_offset= in "
+              "--sim_imus)");
+DEFINE_bool(estimate_time_offset, false,
+            "Estimate each IMU's clock offset online (calibration.estimate_time_offset)");
+DEFINE_string(time_offset, "",
+              "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
+              "mean when estimated, else applied as given");
+DEFINE_string(sim_extrinsic_error, "",
+              "--format sim: hand the odometry a NOMINAL extrinsic off the simulated one by "
+              "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
+              "drawn per --sim_index when omitted; apps/sim extrinsic_error.h); the final "
+              "extrinsic error is reported against the truth");
 DEFINE_string(sim_imu_dropout, "",
               "--format sim: IMU outages start:length[,start:length...] in seconds since the "
               "sequence start (samples inside are absent), e.g. 5:1");
@@ -129,7 +145,13 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     given.beams = Given("sim_beams", FLAGS_sim_beams);
     sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
+    c.imu.stamp_offset_s = FLAGS_sim_imu_stamp_offset;
     c.extra_imus = sim::ParseImuSpecs(FLAGS_sim_imus, c.imu);
+    const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_sim_extrinsic_error);
+    if (!extrinsic_error.IsZero()) {
+      c.nominal_imu_from_lidar = sim::NominalExtrinsic(c.imu_from_lidar, extrinsic_error,
+                                                       sim::kExperimentSeed, FLAGS_sim_index);
+    }
     const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
     std::ostringstream name;
     name << "sim:"
@@ -186,7 +208,14 @@ bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& 
   if (python.empty()) return false;
   std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
   for (const std::string& f : folders) cmd += " '" + f + "'";
-  return std::system((cmd + " >/dev/null").c_str()) == 0;
+  bool ok = std::system((cmd + " >/dev/null").c_str()) == 0;
+  // The online calibration's estimates and ±3σ over time (calibration.png per method folder).
+  for (const std::string& f : folders) {
+    if (!std::filesystem::exists(f + "/calibration.csv")) continue;
+    const std::string c = python + " '" + CTLIO_TOOLS_DIR + "/plot_calibration.py' '" + f + "'";
+    ok = std::system((c + " >/dev/null").c_str()) == 0 && ok;
+  }
+  return ok;
 }
 
 std::vector<std::string> Split(const std::string& s) {
@@ -197,6 +226,41 @@ std::vector<std::string> Split(const std::string& s) {
     if (!item.empty()) out.push_back(item);
   }
   return out;
+}
+
+// With the extrinsic estimated or a perturbed nominal one: the starting and final extrinsic
+// errors against the truth (rotation angle [deg], translation [cm]; sim/extrinsic_error.h), the
+// final marginal σ per axis [ρ: cm; φ: deg] and whether the final error δ = Log(T_true·T_est⁻¹)
+// lies within 3σ on every rotation / translation axis.
+void WriteExtrinsicEvaluation(const lioapp::RunSummary& run, std::ostream& ev) {
+  const bool perturbed =
+      run.true_extrinsic &&
+      (run.true_extrinsic->Matrix() - run.initial_extrinsic.Matrix()).norm() > 0.0;
+  if (!run.extrinsic_estimated && !perturbed) return;
+  ev << "extrinsic_estimated " << (run.extrinsic_estimated ? 1 : 0) << "\n";
+  const SE3& T = run.final_extrinsic;
+  const Eigen::Quaterniond q = T.quaternion();
+  ev << "extrinsic_final_xyz_qxyzw " << T.translation().x() << ' ' << T.translation().y() << ' '
+     << T.translation().z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << "\n";
+  if (run.extrinsic_estimated) {
+    const Vec6& s = run.final_extrinsic_sigma;
+    ev << "extrinsic_sigma_cm " << 100 * s[0] << ' ' << 100 * s[1] << ' ' << 100 * s[2]
+       << "\nextrinsic_sigma_deg " << s[3] * 180 / M_PI << ' ' << s[4] * 180 / M_PI << ' '
+       << s[5] * 180 / M_PI << "\n";
+  }
+  if (!run.true_extrinsic) return;
+  const sim::ExtrinsicErrorSize e0 =
+      sim::MeasureExtrinsicError(run.initial_extrinsic, *run.true_extrinsic);
+  const sim::ExtrinsicErrorSize e1 = sim::MeasureExtrinsicError(T, *run.true_extrinsic);
+  ev << "extrinsic_initial_error_deg " << e0.rotation_deg << "\nextrinsic_initial_error_cm "
+     << 100 * e0.translation_m << "\nextrinsic_error_deg " << e1.rotation_deg
+     << "\nextrinsic_error_cm " << 100 * e1.translation_m << "\n";
+  if (run.extrinsic_estimated) {
+    const sim::SigmaCoverage c =
+        sim::CoveredBySigma(T, *run.true_extrinsic, run.final_extrinsic_sigma);
+    ev << "extrinsic_translation_within_3sigma " << (c.translation ? 1 : 0)
+       << "\nextrinsic_rotation_within_3sigma " << (c.rotation ? 1 : 0) << "\n";
+  }
 }
 
 }  // namespace
@@ -232,6 +296,13 @@ int main(int argc, char** argv) {
         config.frontend.threads = FLAGS_frontend_threads;
       }
       if (!FLAGS_association.empty()) config.frontend.association = FLAGS_association;
+      if (FLAGS_estimate_time_offset) config.calibration.estimate_time_offset = true;
+      if (!FLAGS_time_offset.empty()) {
+        config.calibration.time_offset_s.clear();
+        for (const std::string& d : Split(FLAGS_time_offset)) {
+          config.calibration.time_offset_s.push_back(std::stod(d));
+        }
+      }
       config.Validate();
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
@@ -284,6 +355,7 @@ int main(int argc, char** argv) {
         }
         ev << "\n";
       }
+      WriteExtrinsicEvaluation(run, ev);
       if (!run.nees.empty()) {
         ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
            << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "
@@ -308,6 +380,25 @@ int main(int argc, char** argv) {
         truths.push_back(*source->GroundTruth());
       } else {
         truths.emplace_back();
+      }
+      if (config.calibration.any()) {
+        lioapp::WriteCalibrationLog(out + "/calibration.csv", run);
+        lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run);
+        if (const lio::ScanResult* last = lioapp::LastCalibration(run)) {
+          const auto& c = last->calibration;
+          for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+            ev << "imu" << j << "_time_offset_s " << std::setprecision(9) << c.time_offset_s[j]
+               << "\nimu" << j << "_time_offset_sigma_s "
+               << (j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN) << "\n";
+            if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
+              ev << "imu" << j << "_time_offset_true_s " << *run.true_time_offsets[j] << "\nimu"
+                 << j << "_time_offset_error_s " << c.time_offset_s[j] - *run.true_time_offsets[j]
+                 << "\n";
+            }
+          }
+          ev << std::setprecision(6);
+          // (The extrinsic's lines follow here.)
+        }
       }
       if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
       folders.push_back(out);

@@ -28,6 +28,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
@@ -55,6 +56,10 @@ DEFINE_string(imus, "",
               "Further IMUs (IMU 1, 2, ...), ';'-separated key=value lists: rate, xyz, rpy, "
               "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage (apps/sim "
               "imu_specs.h), e.g. rate=400,xyz=0.3:0:0,offset=0.0013");
+DEFINE_double(imu_stamp_offset, 0.0,
+              "IMU 0's sample of the motion at t is stamped t - this [s] (a clock offset for the "
+              "odometry's online calibration; recorded as true_time_offset_s in ctlio_sim.yaml; "
+              "other IMUs: stamp_offset= in --imus)");
 DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second (Poisson); 0 = none");
 DEFINE_double(imu_outage_min, 0.1, "Shortest random IMU outage [s]");
 DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
@@ -71,6 +76,10 @@ DEFINE_double(bias_walk_accel, 0.0, "Accelerometer bias random walk [m/s²/√s]
 DEFINE_double(bias_walk_gyro, 0.0, "Gyro bias random walk [rad/s/√s]");
 DEFINE_int32(pillars, 0, "Interior 1 m × 1 m pillars placed at random (seeded) in the room");
 DEFINE_bool(ground_truth, true, "Write the ground-truth trajectory");
+DEFINE_string(extrinsic_error, "",
+              "Write a NOMINAL lidar->IMU extrinsic off the true one by <angle>deg[@ax:ay:az],"
+              "<distance>m[@dx:dy:dz] (axis/direction drawn per --index when omitted; the truth "
+              "goes to true_imu_from_lidar), e.g. 3deg,0.10m (apps/sim extrinsic_error.h)");
 DEFINE_bool(newer_college_extrinsic, false,
             "Use the Newer College lidar→IMU extrinsic instead of identity (always used with "
             "--layout=newer_college, which cannot carry another)");
@@ -155,12 +164,23 @@ int main(int argc, char** argv) {
     I.accel_limit = FLAGS_accel_limit;
     I.gyro_limit = FLAGS_gyro_limit;
     I.outages = sim::ParseImuOutages(FLAGS_imu_dropout);
+    I.stamp_offset_s = FLAGS_imu_stamp_offset;
     I.outage_rate = FLAGS_imu_outage_rate;
     I.outage_length_min = FLAGS_imu_outage_min;
     I.outage_length_max = FLAGS_imu_outage_max;
     config.extra_imus = sim::ParseImuSpecs(FLAGS_imus, I);
     // The Newer College layout carries no extrinsic and is read with the published one.
     if (FLAGS_layout == "newer_college") config.imu_from_lidar = io::NewerCollegeImuFromLidar();
+    const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_extrinsic_error);
+    if (!extrinsic_error.IsZero()) {
+      if (FLAGS_layout != "ctlio") {
+        throw std::runtime_error(
+            "--extrinsic_error needs --layout ctlio (the only layout that "
+            "records the true extrinsic next to the nominal one)");
+      }
+      config.nominal_imu_from_lidar =
+          sim::NominalExtrinsic(config.imu_from_lidar, extrinsic_error, FLAGS_seed, FLAGS_index);
+    }
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
     if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
     std::mt19937_64 rng(FLAGS_seed + 17);

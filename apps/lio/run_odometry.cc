@@ -218,6 +218,8 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   run.method = lio::LioMethodName(config.method);
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
+  run.initial_extrinsic = run.final_extrinsic = T_imu_lidar;
+  run.true_extrinsic = source.TrueImuFromLidar();
   const size_t total = options.max_scans > 0
                            ? (source.NumScans() > 0 ? std::min(options.max_scans, source.NumScans())
                                                     : options.max_scans)
@@ -270,11 +272,18 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     if (r.degeneracy.num_degenerate() > 0) ++run.degenerate_direction_scans;
     if (r.status != lio::ScanStatus::kFailed) {
       if (!r.imu_biases.empty()) run.final_biases = r.imu_biases;
-      run.trajectory.push_back({r.t_ns, r.T_mr * T_imu_lidar});
+      // The lidar pose with the extrinsic estimated at this scan, when it is estimated.
+      const SE3& T_rl = r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar;
+      if (r.calibration.has_extrinsic) {
+        run.extrinsic_estimated = true;
+        run.final_extrinsic = r.calibration.T_imu_lidar;
+        run.final_extrinsic_sigma = r.calibration.extrinsic_sigma;
+      }
+      run.trajectory.push_back({r.t_ns, r.T_mr * T_rl});
       if (options.trajectory_rate_hz > 0.0) {
         auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
         if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
-        for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_imu_lidar});
+        for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_rl});
       }
     }
     run.scans.push_back(r);
@@ -312,7 +321,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
     if (config.pose_covariance) PoseNees(run.scans, *truth, T_imu_lidar, &run);
   }
-  for (const io::ImuInfo& info : source.Imus()) run.true_biases.push_back(info.true_bias);
+  for (const io::ImuInfo& info : source.Imus()) {
+    run.true_biases.push_back(info.true_bias);
+    run.true_time_offsets.push_back(info.true_time_offset_s);
+  }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
   return run;

@@ -40,7 +40,8 @@ struct RunSummary {
   std::string source;
   std::string extrinsic_origin;  // where T_imu_lidar came from
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
-  // estimated (failed scans are left out, never written as garbage).
+  // estimated (failed scans are left out, never written as garbage); with the extrinsic
+  // estimated online (calibration.estimate_extrinsic), T_mr·T_imu_lidar of that scan's estimate.
   std::vector<io::StampedPose> trajectory;
   // With RunOptions::trajectory_rate_hz: T_world_lidar at that rate (LioOdometry::
   // SampleNewestInterval after every estimated scan), ending at each scan pose.
@@ -75,10 +76,20 @@ struct RunSummary {
   // initial biases where the source knows them (simulator).
   std::vector<Vec6> final_biases;
   std::vector<std::optional<Vec6>> true_biases;
+  // The true clock offset of every IMU where the source knows it (simulator's stamp_offset), to
+  // compare the online calibration's estimate with (ScanResult::calibration).
+  std::vector<std::optional<double>> true_time_offsets;
   // Consistency (config.pose_covariance and ground truth): per estimated scan after the first,
   // the NEES of the pose, ε = Log(T_mr,true·T_mr⁻¹), εᵀΣ⁻¹ε (6 if consistent), and of its
   // translation and rotation parts alone (3 each), with T_mr,true anchored at the first scan.
   std::vector<double> nees, nees_translation, nees_rotation;
+  // Extrinsic T_imu_lidar: the one the run started from (config or source), the last estimated
+  // one with its marginal σ [ρ; φ] (calibration.estimate_extrinsic; else the starting one, σ 0),
+  // and the truth where the source knows it (simulator: DataSource::TrueImuFromLidar).
+  SE3 initial_extrinsic, final_extrinsic;
+  bool extrinsic_estimated = false;
+  Vec6 final_extrinsic_sigma = Vec6::Zero();
+  std::optional<SE3> true_extrinsic;
   // The run is a failure if a scan failed after initialisation or the ATE exceeds
   // `failure_ate` (the estimate left the room of any sensible error).
   bool failure = false;

@@ -19,6 +19,7 @@
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
+#include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 
@@ -106,6 +107,25 @@ TEST(SimFolder, SimulatorWrittenInCtlioLayoutReadsBackEndToEnd) {
   sim::SimulatedSource truth(SmallSim());
   ExpectSameData(*reader, truth, 1e-12);
   EXPECT_TRUE(fs::exists(d / "ground_truth_tum.txt"));
+}
+
+// A perturbed nominal extrinsic (calibration experiments): the folder's imu_from_lidar is the
+// nominal one, true_imu_from_lidar the truth; without an error the key is not written.
+TEST(SimFolder, TrueExtrinsicRoundTripsNextToTheNominal) {
+  const fs::path d = TempDir("extrinsic_error");
+  sim::SimConfig c = SmallSim();
+  c.nominal_imu_from_lidar = sim::NominalExtrinsic(
+      c.imu_from_lidar, sim::ParseExtrinsicError("3deg,0.1m"), sim::kExperimentSeed, 0);
+  sim::SimulatedSource source(c);
+  WriteSimFolder(source, d.string());
+  SimFolderReader reader(d.string());
+  EXPECT_LT((reader.ImuFromLidar().Matrix() - c.nominal_imu_from_lidar->Matrix()).norm(), 1e-12);
+  ASSERT_TRUE(reader.TrueImuFromLidar().has_value());
+  EXPECT_LT((reader.TrueImuFromLidar()->Matrix() - c.imu_from_lidar.Matrix()).norm(), 1e-12);
+  const fs::path plain = TempDir("extrinsic_none");
+  sim::SimulatedSource unperturbed(SmallSim());
+  WriteSimFolder(unperturbed, plain.string());
+  EXPECT_FALSE(SimFolderReader(plain.string()).TrueImuFromLidar().has_value());
 }
 
 // Two asynchronous IMUs (200 Hz in the body frame + 400 Hz rotated on a lever arm, clock start

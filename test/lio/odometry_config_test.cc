@@ -66,5 +66,43 @@ TEST(OdometryConfig, BadValuesAreErrors) {
   EXPECT_THROW(ParseLioMethod("singer"), std::invalid_argument);
 }
 
+TEST(OdometryConfig, CalibrationSection) {
+  // Off by default (and in the shipped configs).
+  const OdometryConfig sim =
+      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  EXPECT_FALSE(sim.calibration.any());
+  const OdometryConfig c = LoadOdometryConfig(
+      WriteTemp("cal.yaml",
+                "calibration:\n  estimate_time_offset: true\n  time_offset_s: [0.02]\n"
+                "  time_offset_prior_sigma_s: 0.05\n  estimate_extrinsic: true\n"
+                "  extrinsic_prior_sigma_deg: 3\n  extrinsic_prior_sigma_m: 0.1\n"));
+  EXPECT_TRUE(c.calibration.estimate_time_offset);
+  EXPECT_TRUE(c.calibration.estimate_extrinsic);
+  ASSERT_EQ(c.calibration.time_offset_s.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.calibration.TimeOffset(0), 0.02);
+  EXPECT_DOUBLE_EQ(c.calibration.time_offset_prior_sigma_s, 0.05);
+  EXPECT_DOUBLE_EQ(c.calibration.extrinsic_prior_sigma_deg, 3.0);
+  EXPECT_DOUBLE_EQ(c.calibration.extrinsic_prior_sigma_m, 0.1);
+  // Bad values name file and line; the section is not per method; one offset per IMU of imus.
+  const std::string bad = WriteTemp("cal_bad.yaml", "calibration:\n  time_offset_s: 0.02x\n");
+  try {
+    LoadOdometryConfig(bad);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + ":2"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(
+      LoadOdometryConfig(WriteTemp("cal_s.yaml", "calibration:\n  time_offset_prior_sigma_s: 0\n")),
+      std::runtime_error);
+  EXPECT_THROW(LoadOdometryConfig(
+                   WriteTemp("cal_pm.yaml", "per_method:\n  lidar_gyro:\n    calibration: {}\n")),
+               std::runtime_error);
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp("cal_n.yaml",
+                                            "imus:\n  - {xyz_rpy: [0, 0, 0, 0, 0, 0]}\n"
+                                            "  - {xyz_rpy: [0, 0, 0, 0, 0, 0]}\n"
+                                            "calibration:\n  time_offset_s: [0.01]\n")),
+               std::runtime_error);
+}
+
 }  // namespace
 }  // namespace ctlio::lio

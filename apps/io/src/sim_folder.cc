@@ -126,6 +126,9 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       throw std::runtime_error("gravity " + std::to_string(gravity_) + " is not in (0, 100) m/s²");
     }
     imu_from_lidar_ = ReadPose(meta["imu_from_lidar"], "imu_from_lidar");
+    if (meta["true_imu_from_lidar"]) {
+      true_imu_from_lidar_ = ReadPose(meta["true_imu_from_lidar"], "true_imu_from_lidar");
+    }
     if (version_ == 1) {  // one IMU in imu.csv, the body frame
       imus_.push_back(ImuInfo{});
       imu_files.push_back("imu.csv");
@@ -158,6 +161,7 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
           b << ba[0], ba[1], ba[2], bg[0], bg[1], bg[2];
           info.true_bias = b;
         }
+        if (n["true_time_offset_s"]) info.true_time_offset_s = n["true_time_offset_s"].as<double>();
         imus_.push_back(info);
         imu_files.push_back(file);
       }
@@ -262,6 +266,12 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     y << YAML::Key << "source" << YAML::Value << source.Name();
     y << YAML::Key << "gravity" << YAML::Value << source.Gravity().value_or(9.81);
     EmitPose(y, "imu_from_lidar", source.ImuFromLidar());
+    // Only when the nominal extrinsic is not the truth (a calibration experiment): files of the
+    // usual datasets stay as they were.
+    const std::optional<SE3> truth = source.TrueImuFromLidar();
+    if (truth && (truth->Matrix() - source.ImuFromLidar().Matrix()).norm() > 0.0) {
+      EmitPose(y, "true_imu_from_lidar", *truth);
+    }
     y << YAML::Key << "imus" << YAML::Value << YAML::BeginSeq;
     for (size_t j = 0; j < imus.size(); ++j) {
       const ImuInfo& info = imus[j];
@@ -277,6 +287,9 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
           << std::vector<double>{b[0], b[1], b[2]};
         y << YAML::Key << "gyro_bias" << YAML::Value << YAML::Flow
           << std::vector<double>{b[3], b[4], b[5]};
+      }
+      if (info.true_time_offset_s) {
+        y << YAML::Key << "true_time_offset_s" << YAML::Value << *info.true_time_offset_s;
       }
       y << YAML::EndMap;
     }

@@ -5,6 +5,7 @@
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
 #include "ctlio/manifolds/pose_manifold.h"
 
 namespace ctlio::lio {
@@ -34,6 +35,7 @@ void ContinuousLidarTerm::BeginRound() {
   located_.assign(firings_.size(), false);
   // Until a residual of this round reads it, the callback need not prepare a firing.
   for (const auto& f : firings_) f->set_active(false);
+  if (extrinsic_ != nullptr) T_rl_ = PoseManifold::Pose(extrinsic_);
 }
 
 void ContinuousLidarTerm::Locate(size_t i, Vec3* q, Vec3* p_map) {
@@ -44,8 +46,9 @@ void ContinuousLidarTerm::Locate(size_t i, Vec3* q, Vec3* p_map) {
     T_mr_[f] = firings_[f]->pose().Inverse();
     located_[f] = true;
   }
-  *q = keypoints_[i].point;
-  *p_map = T_mr_[f] * keypoints_[i].point;
+  // With calibration the robot-frame point follows the extrinsic's current estimate.
+  *q = extrinsic_ != nullptr ? T_rl_ * points_lidar_[i] : keypoints_[i].point;
+  *p_map = T_mr_[f] * *q;
 }
 
 ceres::ResidualBlockId ContinuousLidarTerm::AddResidual(size_t i,
@@ -54,7 +57,24 @@ ceres::ResidualBlockId ContinuousLidarTerm::AddResidual(size_t i,
                                                         SlidingWindow* window) {
   const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
   firing->set_active(true);
+  if (extrinsic_ != nullptr) {
+    std::vector<StateId> states = states_;
+    states.push_back(kExtrinsicKey);
+    return window->AddResidualBlock(
+        new ContinuousPointToPlaneExtrinsic(firing, association, points_lidar_[i]), loss, states);
+  }
   return window->AddResidualBlock(new ContinuousPointToPlane(firing, association), loss, states_);
+}
+
+ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                                         const KnotKeys& k, const KnotKeys& k1,
+                                         const std::vector<TimedPoint>& keypoints,
+                                         const SE3& T_robot_lidar, SlidingWindow* window)
+    : ContinuousLidarTerm(model, t_k, t_k1, k, k1, keypoints, window) {
+  extrinsic_ = window->State(kExtrinsicKey);
+  const SE3 T_lidar_robot = T_robot_lidar.Inverse();
+  points_lidar_.reserve(keypoints.size());
+  for (const TimedPoint& p : keypoints) points_lidar_.push_back(T_lidar_robot * p.point);
 }
 
 SE3 ContinuousLidarTerm::NewestPose() const { return PoseManifold::Pose(blocks_[3]); }

@@ -14,6 +14,7 @@
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/input_checks.h"
+#include "ctlio/solvers/lio/state_keys.h"
 
 namespace ctlio::lio {
 
@@ -223,6 +224,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
   if (config_.pose_covariance) ReportPoseCovariance(result);
+  if (config_.calibration.any()) ReportCalibrationCovariance(result);
 }
 
 void LioOdometry::ReportPoseCovariance(ScanResult* result) {
@@ -240,6 +242,47 @@ void LioOdometry::ReportPoseCovariance(ScanResult* result) {
   const Mat6 M = result->T_mr.Adjoint() * estimator_->NewestPoseTangentFromBody().inverse();
   result->pose_covariance = M * Mat6(block) * M.transpose();
   result->has_pose_covariance = true;
+}
+
+void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
+  // The calibration states in the window (the estimators that have them), all in one
+  // ceres::Covariance: the clock offsets (1-D each) and the extrinsic T_imu_lidar (pose block).
+  std::vector<const double*> offsets;
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    if (window_.HasState(TimeOffsetKey(j))) offsets.push_back(window_.State(TimeOffsetKey(j)));
+  }
+  const double* extrinsic = result->calibration.has_extrinsic && window_.HasState(kExtrinsicKey)
+                                ? window_.State(kExtrinsicKey)
+                                : nullptr;
+  if (offsets.empty() && extrinsic == nullptr) return;
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const double* x : offsets) blocks.emplace_back(x, x);
+  if (extrinsic != nullptr) blocks.emplace_back(extrinsic, extrinsic);
+  ceres::Covariance::Options options;
+  if (extrinsic != nullptr) {
+    // Dense SVD (the window has < 100 tangent parameters) with the null space dropped: C_mi,
+    // refined with the extrinsic, has a null direction (the yaw about gravity), which the default
+    // sparse QR refuses; the pseudo-inverse gives the calibration's marginal σ.
+    options.algorithm_type = ceres::DENSE_SVD;
+    options.null_space_rank = -1;
+  }
+  // Otherwise sparse QR: a rank-deficient window gives no σ (NaN) rather than a pseudo-inverse.
+  ceres::Covariance covariance(options);
+  const bool ok = covariance.Compute(blocks, &window_.problem());
+  auto& cal = result->calibration;
+  cal.time_offset_sigma_s.clear();
+  for (const double* x : offsets) {
+    double var = std::nan("");
+    if (ok) covariance.GetCovarianceBlockInTangentSpace(x, x, &var);
+    cal.time_offset_sigma_s.push_back(var >= 0.0 ? std::sqrt(var) : std::nan(""));
+  }
+  if (extrinsic != nullptr && ok) {
+    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
+    if (covariance.GetCovarianceBlockInTangentSpace(extrinsic, extrinsic, block.data())) {
+      // PoseManifold's left perturbation [ρ; φ] of T_rl.
+      cal.extrinsic_sigma = block.diagonal().cwiseMax(0.0).cwiseSqrt();
+    }
+  }
 }
 
 void LioOdometry::Slide(ScanResult* result) {
@@ -283,11 +326,16 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   const std::vector<size_t> kept =
       RangeGatedVoxelIndices(scan.points, frontend_.NextVoxelSize(), config_.frontend.min_range,
                              config_.frontend.max_range, config_.frontend.threads);
+  // The configured extrinsic, or with online calibration its current estimate (the lidar
+  // residuals recover the lidar-frame points through prepared.T_robot_lidar).
+  prepared.T_robot_lidar =
+      window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
+  const SE3& T_robot_lidar = prepared.T_robot_lidar;
   std::vector<TimedPoint> raw;
   raw.reserve(kept.size());
   for (const size_t i : kept) {
     TimedPoint p;
-    p.point = config_.T_imu_lidar * scan.points[i];
+    p.point = T_robot_lidar * scan.points[i];
     // Points are registered between the previous knot and this one; a time outside by less than
     // input.scan_time_tolerance (clock jitter of the driver; the rest was dropped and counted in
     // DropPointsOutsideInterval) is clamped onto the interval rather than extrapolated.

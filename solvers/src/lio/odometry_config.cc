@@ -122,6 +122,11 @@ void OdometryConfig::Validate() const {
           "imu.input_imu must index an IMU of imus");
   require(solver_threads >= 1, "window solver settings must be >= 1");
   degeneracy.Validate();
+  calibration.Validate();
+  require(calibration.time_offset_s.empty() ||
+              (imus.empty() ? calibration.time_offset_s.size() <= 5
+                            : calibration.time_offset_s.size() == imus.size()),
+          "calibration.time_offset_s needs one value per IMU of imus");
 }
 
 namespace {
@@ -147,7 +152,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     const YAML::Node& v = kv.second;
     const std::string section = where + key;
     if (top == nullptr && (key == "method" || key == "extrinsic" || key == "input" ||
-                           key == "per_method" || key == "imus")) {
+                           key == "per_method" || key == "imus" || key == "calibration")) {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": '" + section +
                                "' cannot be set per method");
     }
@@ -216,6 +221,15 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"rotation_threshold", SetFromYaml(&c->degeneracy.rotation_threshold)},
                    {"remap_information", SetFromYaml(&c->degeneracy.remap_information)},
                    {"remap", SetFromYaml(&c->degeneracy.remap)}});
+    } else if (key == "calibration") {
+      CalibrationOptions& o = c->calibration;
+      ReadSection(v, section, source,
+                  {{"estimate_time_offset", SetFromYaml(&o.estimate_time_offset)},
+                   {"time_offset_s", SetFromYaml(&o.time_offset_s)},
+                   {"time_offset_prior_sigma_s", SetFromYaml(&o.time_offset_prior_sigma_s)},
+                   {"estimate_extrinsic", SetFromYaml(&o.estimate_extrinsic)},
+                   {"extrinsic_prior_sigma_deg", SetFromYaml(&o.extrinsic_prior_sigma_deg)},
+                   {"extrinsic_prior_sigma_m", SetFromYaml(&o.extrinsic_prior_sigma_m)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

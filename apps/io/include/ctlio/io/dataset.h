@@ -33,6 +33,9 @@ struct ImuInfo {
   double gyro_sigma = 0.0;   // rad/s
   // The true initial biases [b_a; b_g] when known (simulated data), for evaluation only.
   std::optional<Vec6> true_bias;
+  // The true clock offset δ when known (simulated data, for evaluation only): a sample stamped t
+  // measures the motion at t + δ (what the odometry's calibration.time_offset_s should find).
+  std::optional<double> true_time_offset_s;
 };
 
 // A timestamped pose. In ground truth it is T_world_lidar: the lidar frame's pose in a fixed world
@@ -68,6 +71,9 @@ class DataSource {
   virtual SE3 ImuFromLidar() const = 0;
   // Where ImuFromLidar comes from, for the log ("dataset files", "bag /tf_static", "preset ...").
   virtual std::string ExtrinsicOrigin() const { return "the dataset (" + Name() + ")"; }
+  // The true T_imu_lidar where the source knows it (simulator), which may differ from the
+  // nominal ImuFromLidar (calibration experiments).
+  virtual std::optional<SE3> TrueImuFromLidar() const { return std::nullopt; }
   // Ground truth T_world_lidar, time-sorted, if the source has it.
   virtual std::optional<std::vector<StampedPose>> GroundTruth() const { return std::nullopt; }
   // Gravity magnitude the IMU data assume, if the source knows it (simulator: exact value).

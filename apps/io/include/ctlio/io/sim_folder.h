@@ -1,5 +1,7 @@
 // ctlio's own simulator folder layout (documented in README.md, "Dataset folders"):
 //   ctlio_sim.yaml        format: ctlio_sim, version: 2, gravity, imu_from_lidar (T_body_lidar),
+//                         optional true_imu_from_lidar (the truth when imu_from_lidar is a
+//                         perturbed nominal one, sim/extrinsic_error.h),
 //                         imus (per IMU: name, file, body_from_imu, rate_hz, accel_noise,
 //                         gyro_noise, optional true accel_bias/gyro_bias), free `config`
 //   imu.csv               header "t_ns,wx,wy,wz,ax,ay,az": the first IMU (imu1.csv, imu2.csv, ...
@@ -28,6 +30,7 @@ class SimFolderReader : public DataSource {
   size_t NumScans() const override { return scans_.size(); }
   bool Next(ScanFrame* frame) override;
   SE3 ImuFromLidar() const override { return imu_from_lidar_; }
+  std::optional<SE3> TrueImuFromLidar() const override { return true_imu_from_lidar_; }
   std::optional<std::vector<StampedPose>> GroundTruth() const override;
   std::optional<double> Gravity() const override { return gravity_; }
   std::vector<ImuInfo> Imus() const override { return imus_; }
@@ -44,6 +47,7 @@ class SimFolderReader : public DataSource {
   };
   std::string folder_;
   SE3 imu_from_lidar_;
+  std::optional<SE3> true_imu_from_lidar_;
   double gravity_ = 9.81;
   int version_ = 1;
   std::vector<ImuInfo> imus_;

@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -132,6 +133,10 @@ struct ImuConfig {
   // the first sample after the sequence start [s] (samples at start + offset + k/rate).
   SE3 body_from_imu;
   double clock_offset_s = 0.0;
+  // Stamp offset δ [s]: the sample measuring the motion at t carries the stamp t − δ (an IMU clock
+  // δ behind the lidar's); δ is what the odometry's online time-offset calibration should find
+  // (recorded as the IMU's true_time_offset_s). 0: stamps are the true times.
+  double stamp_offset_s = 0.0;
 };
 
 struct SimConfig {
@@ -144,6 +149,10 @@ struct SimConfig {
   int64_t start_ns = 0;                                        // absolute time of t = 0
   SE3 world_from_imu0 = SE3(Mat3::Identity(), Vec3(0, 0, 2));  // T_wb(0) (unguided motion)
   SE3 imu_from_lidar;                                          // T_bl (identity by default)
+  // The extrinsic handed out as the sensor setup's (dataset file, ImuFromLidar), when it differs
+  // from the true imu_from_lidar the lidar moves with (calibration experiments,
+  // extrinsic_error.h); unset = the truth.
+  std::optional<SE3> nominal_imu_from_lidar;
   // Further IMUs (IMU 1, 2, ...; `imu` is IMU 0). Each gets its own noise stream, so IMU 0's
   // samples are the same with or without them.
   std::vector<ImuConfig> extra_imus;
@@ -230,7 +239,11 @@ class SimulatedSource : public io::DataSource {
   std::string Name() const override { return name_; }
   size_t NumScans() const override { return sim_.NumScans(); }
   bool Next(io::ScanFrame* frame) override;
-  SE3 ImuFromLidar() const override { return sim_.config().imu_from_lidar; }
+  // The nominal extrinsic (SimConfig::nominal_imu_from_lidar if set); the truth below.
+  SE3 ImuFromLidar() const override {
+    return sim_.config().nominal_imu_from_lidar.value_or(sim_.config().imu_from_lidar);
+  }
+  std::optional<SE3> TrueImuFromLidar() const override { return sim_.config().imu_from_lidar; }
   std::optional<std::vector<io::StampedPose>> GroundTruth() const override;
   std::optional<double> Gravity() const override { return sim_.config().imu.gravity; }
   std::vector<io::ImuInfo> Imus() const override;

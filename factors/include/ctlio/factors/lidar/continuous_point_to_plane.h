@@ -69,8 +69,8 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
   const PlaneAssociation& association() const { return m_; }
   const SharedPoseInterpolation& pose() const { return *pose_; }
 
- private:
-  // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks.
+  // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks
+  // (also used by the variant with the extrinsic, continuous_point_to_plane_extrinsic.h).
   static void WriteKnotJacobians(const Eigen::Matrix<double, 1, 18>& J, const double* pose,
                                  double** out) {
     if (out[0] != nullptr) LiftPoseJacobian<1>(J.leftCols<6>(), pose, out[0]);
@@ -79,6 +79,7 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
     if (out[2] != nullptr) Row6{out[2]} = J.rightCols<6>();
   }
 
+ private:
   std::shared_ptr<const SharedPoseInterpolation> pose_;
   PlaneAssociation m_;
 };

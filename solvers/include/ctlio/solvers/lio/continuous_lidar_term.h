@@ -3,6 +3,9 @@
 // (same τ) share one SharedPoseInterpolation (its gp::GpInterpolator's Λ, Ω depend on the times
 // only: built once per scan), which the window's evaluation callback fills once per evaluation
 // (SlidingWindow::shared_interpolations()) and the association reads at the current estimate.
+// With the extrinsic estimated (online calibration, kExtrinsicKey in the window), every keypoint
+// is a ContinuousPointToPlaneExtrinsic of its lidar-frame point instead, and the association
+// places it with the extrinsic's current estimate.
 #pragma once
 
 #include <array>
@@ -26,6 +29,11 @@ class ContinuousLidarTerm final : public LidarTerm {
   ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
                       const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
                       SlidingWindow* window);
+  // With the extrinsic T_rl estimated: the window's kExtrinsicKey block; `T_robot_lidar` is the
+  // extrinsic the keypoints were moved into the robot frame with (PreparedScan::T_robot_lidar).
+  ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
+                      const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
+                      const SE3& T_robot_lidar, SlidingWindow* window);
 
   size_t num_keypoints() const override { return keypoints_.size(); }
   void BeginRound() override;
@@ -45,6 +53,11 @@ class ContinuousLidarTerm final : public LidarTerm {
   // Per firing, this round: the map pose at the current estimate (for the association).
   std::vector<SE3> T_mr_;
   std::vector<bool> located_;
+  // Online calibration only (else empty / null): the keypoints in the lidar frame, the extrinsic
+  // block and its value this round.
+  std::vector<Vec3> points_lidar_;
+  const double* extrinsic_ = nullptr;
+  SE3 T_rl_;
 };
 
 }  // namespace ctlio::lio

@@ -26,6 +26,9 @@ struct PreparedScan {
   int64_t end_ns = 0;
   std::vector<TimedPoint> points;     // range-gated and subsampled, robot frame, time order
   std::vector<TimedPoint> keypoints;  // subset used in the residuals, time order
+  // The extrinsic T_imu_lidar that moved the points into the robot frame: the configured one, or
+  // the current estimate with online calibration (T_robot_lidar⁻¹ recovers the lidar-frame point).
+  SE3 T_robot_lidar;
 };
 
 class Estimator {

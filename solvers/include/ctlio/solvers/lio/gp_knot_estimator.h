@@ -7,6 +7,15 @@
 // Several IMUs (OdometryConfig::imus): every sample of every IMU is a measurement of the state at
 // its own time with its IMU's mounting (lever arm and rotation, imu_mounting.h) and noise, and
 // each IMU has its own bias blocks (KnotKeys::Bias) with their own random walk.
+// Clock offsets (OdometryConfig::calibration, Singer-LIO and lidar_gyro): IMU j's sample stamped
+// t measures the state at t + δ_j. Estimated: one 1-D block per IMU (TimeOffsetKey) with a
+// Gaussian prior, read by the time-offset IMU factors (imu_gyro_time_offset.h); a sample goes to
+// the interval that holds t + δ̄_j for the estimate δ̄_j when its knot is added (each sample once:
+// the stamps taken follow on from the previous interval's). Configured but not estimated: the
+// fixed-time factors at t + δ_j. Neither: the estimator without offsets, bit for bit.
+// Online calibration (OdometryConfig::calibration.estimate_extrinsic): the extrinsic T_rl is a
+// static state (kExtrinsicKey) with a prior on the configured value, read by every lidar
+// residual (ContinuousPointToPlaneExtrinsic); the map points are placed with its estimate.
 #pragma once
 
 #include <deque>
@@ -56,6 +65,7 @@ class GpKnotEstimator final : public Estimator {
     std::vector<double*> bias;  // per IMU; empty for lidar_only
   };
   bool uses_imu() const { return config_.method != LioMethod::kLidarOnly; }
+  bool estimates_extrinsic() const { return config_.calibration.estimate_extrinsic; }
   int num_imus() const { return uses_imu() ? config_.num_imus() : 0; }
   // `bias`: the initial value of every IMU's bias, per IMU.
   Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw,
@@ -66,13 +76,20 @@ class GpKnotEstimator final : public Estimator {
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,
                           ScanResult* result) const;
+  // Clock offsets in use (estimated or configured non-zero), and IMU j's current δ_j.
+  bool time_offsets() const { return uses_imu() && time_offsets_; }
+  double TimeOffset(int imu, const SlidingWindow& window) const;
 
   OdometryConfig config_;
   const ImuBuffer& imu_;
   gp::SingerModel<6> model_;
   std::vector<imu::ImuMounting> mountings_;  // per IMU
   std::deque<Knot> knots_;                   // oldest first
+  double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
+  bool time_offsets_ = false;
+  std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
+  const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
 };
 
 }  // namespace ctlio::lio

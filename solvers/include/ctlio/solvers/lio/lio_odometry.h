@@ -89,6 +89,9 @@ class LioOdometry {
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   void ReportPoseCovariance(ScanResult* result);
+  // With online calibration: the marginal σ of the calibration states (clock offsets, extrinsic;
+  // one ceres::Covariance of the window, as ReportPoseCovariance) into result->calibration.
+  void ReportCalibrationCovariance(ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;

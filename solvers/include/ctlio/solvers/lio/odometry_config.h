@@ -17,6 +17,7 @@
 #include "ctlio/factors/imu/imu_data.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/manifolds/types.h"
+#include "ctlio/solvers/lio/calibration_options.h"
 #include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/input_check_options.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
@@ -128,6 +129,10 @@ struct OdometryConfig {
   // default: it costs one more Jacobian evaluation and a factorisation per scan.
   bool pose_covariance = false;
 
+  // --- Online lidar–IMU calibration (top-level YAML section `calibration`, calibration_options.h;
+  // Singer-LIO and lidar_gyro): time offset per IMU and extrinsic T_imu_lidar as estimated states.
+  CalibrationOptions calibration;
+
   // --- Per-method overrides (YAML key `per_method`): the complete configuration to use when
   // running that method, i.e. this one with the override's keys replaced. One file can so
   // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side.
@@ -139,12 +144,12 @@ struct OdometryConfig {
 };
 
 // Reads a YAML file: top-level keys `method`, `gp`, `imu`, `init`, `window`, `extrinsic`,
-// `lidar_frontend`, `degeneracy`, `input` and `per_method`. Missing keys keep their defaults;
-// unknown keys and bad values throw std::runtime_error naming file and line. `per_method` maps a
-// method name (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`, `imu`, `init`,
-// `window`, `lidar_frontend` whose keys replace the base values for that method only (same keys,
-// same checks; `method`, `extrinsic` and `input` — properties of the data — cannot be set per
-// method):
+// `lidar_frontend`, `degeneracy`, `input`, `imus`, `calibration` and `per_method`. Missing keys
+// keep their defaults; unknown keys and bad values throw std::runtime_error naming file and line.
+// `per_method` maps a method name (singer_lio, lidar_gyro, lidar_only, imu_input) to sections `gp`,
+// `imu`, `init`, `window`, `lidar_frontend` whose keys replace the base values for that method only
+// (same keys, same checks; `method`, `extrinsic`, `input`, `imus` and `calibration` — properties of
+// the data — cannot be set per method):
 //   lidar_frontend: {max_iterations: 3}
 //   per_method:
 //     imu_input: {lidar_frontend: {max_iterations: 5}}
@@ -201,6 +206,15 @@ struct ScanResult {
   // CPU time of this scan's thread (CLOCK_THREAD_CPUTIME_ID): unlike the wall times above it
   // does not grow when other processes share the cores.
   double cpu_ms = 0.0;
+  // Online calibration (OdometryConfig::calibration) after this scan: the estimates and their
+  // marginal σ (ceres::Covariance of the window). Empty / false when not estimated.
+  struct CalibrationEstimate {
+    std::vector<double> time_offset_s;        // δ_j per IMU [s]
+    std::vector<double> time_offset_sigma_s;  // marginal σ of δ_j [s]
+    bool has_extrinsic = false;
+    SE3 T_imu_lidar;
+    Vec6 extrinsic_sigma = Vec6::Zero();  // marginal σ, [ρ; φ] (m, rad)
+  } calibration;
 };
 
 }  // namespace ctlio::lio

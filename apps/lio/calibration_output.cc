@@ -1,0 +1,114 @@
+#include "lio/calibration_output.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+
+#include "ctlio/io/checked_output.h"
+
+namespace ctlio::lioapp {
+
+const lio::ScanResult* LastCalibration(const RunSummary& run) {
+  for (auto it = run.scans.rbegin(); it != run.scans.rend(); ++it) {
+    if (!it->calibration.time_offset_s.empty() || it->calibration.has_extrinsic) return &*it;
+  }
+  return nullptr;
+}
+
+void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
+  const lio::ScanResult* last = LastCalibration(run);
+  const size_t imus = last != nullptr ? last->calibration.time_offset_s.size() : 0;
+  std::ofstream f = io::OpenForWriting(path);
+  f << "t_s";
+  for (size_t j = 0; j < imus; ++j) {
+    f << ",time_offset_" << j << "_s,time_offset_" << j << "_sigma_s";
+  }
+  // The extrinsic as its deviation from the starting (configured) value in the tangent of its
+  // marginal σ: T_rl = Exp([ρ; φ])·T_rl,start (PoseManifold's left perturbation), φ in degrees.
+  const bool extrinsic = last != nullptr && last->calibration.has_extrinsic;
+  static const char* kAxes[] = {"x", "y", "z"};
+  if (extrinsic) {
+    for (const char* a : kAxes)
+      f << ",extrinsic_rho_" << a << "_m,extrinsic_rho_" << a << "_sigma_m";
+    for (const char* a : kAxes) {
+      f << ",extrinsic_phi_" << a << "_deg,extrinsic_phi_" << a << "_sigma_deg";
+    }
+  }
+  f << "\n" << std::setprecision(10);
+  for (const lio::ScanResult& r : run.scans) {
+    const auto& c = r.calibration;
+    if (c.time_offset_s.size() != imus || (imus == 0 && !extrinsic)) continue;
+    if (extrinsic && !c.has_extrinsic) continue;
+    f << 1e-9 * static_cast<double>(r.t_ns);
+    for (size_t j = 0; j < imus; ++j) {
+      const double sigma = j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN;
+      f << ',' << c.time_offset_s[j] << ',' << sigma;
+    }
+    if (extrinsic) {
+      const Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
+      const double deg = 180.0 / M_PI;
+      for (int i = 0; i < 3; ++i) f << ',' << d[i] << ',' << c.extrinsic_sigma[i];
+      for (int i = 3; i < 6; ++i) f << ',' << deg * d[i] << ',' << deg * c.extrinsic_sigma[i];
+    }
+    f << "\n";
+  }
+  io::CloseChecked(f, path);
+}
+
+bool WriteCalibrationYaml(const std::string& path, const RunSummary& run) {
+  const lio::ScanResult* last = LastCalibration(run);
+  if (last == nullptr) return false;
+  const auto& c = last->calibration;
+  std::ofstream f = io::OpenForWriting(path);
+  f << std::setprecision(9);
+  f << "# Online calibration of " << run.method << " on " << run.source << " after "
+    << 1e-9 * static_cast<double>(last->t_ns - run.scans.front().t_ns) << " s.\n"
+    << "# Paste into the odometry config (README \"Online calibration\").\n";
+  if (!c.time_offset_s.empty()) {
+    for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+      f << "# IMU " << j << ": time offset " << 1e3 * c.time_offset_s[j] << " ms, sigma "
+        << (j < c.time_offset_sigma_s.size() ? 1e3 * c.time_offset_sigma_s[j] : NAN) << " ms";
+      if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
+        f << ", truth " << 1e3 * *run.true_time_offsets[j] << " ms, error "
+          << 1e3 * (c.time_offset_s[j] - *run.true_time_offsets[j]) << " ms";
+      }
+      f << "\n";
+    }
+  }
+  f << "calibration:\n";
+  if (!c.time_offset_s.empty()) {
+    f << "  time_offset_s: [";
+    for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+      f << (j > 0 ? ", " : "") << c.time_offset_s[j];
+    }
+    f << "]\n";
+  }
+  io::CloseChecked(f, path);
+  if (!c.has_extrinsic) return true;
+  // The `extrinsic:` section (top level, beside `calibration:`), in the config's own keys.
+  std::ofstream e(path, std::ios::app);
+  const Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
+  const Vec6& s = c.extrinsic_sigma;
+  const double deg = 180.0 / M_PI;
+  e << std::setprecision(9) << "# Extrinsic T_imu_lidar: moved by rho = [" << d[0] << ", " << d[1]
+    << ", " << d[2] << "] m, phi = [" << deg * d[3] << ", " << deg * d[4] << ", " << deg * d[5]
+    << "] deg from the start; sigma [" << s[0] << ", " << s[1] << ", " << s[2] << "] m, ["
+    << deg * s[3] << ", " << deg * s[4] << ", " << deg * s[5] << "] deg";
+  if (run.true_extrinsic) {
+    const Vec6 err = (c.T_imu_lidar * run.true_extrinsic->Inverse()).Log();
+    const Vec6 t = (*run.true_extrinsic * run.initial_extrinsic.Inverse()).Log();
+    e << "; error vs truth " << 100.0 * err.head<3>().norm() << " cm, "
+      << deg * err.tail<3>().norm() << " deg\n# Extrinsic truth from the start: rho = [" << t[0]
+      << ", " << t[1] << ", " << t[2] << "] m, phi = [" << deg * t[3] << ", " << deg * t[4] << ", "
+      << deg * t[5] << "] deg";
+  }
+  e << "\nextrinsic:\n  rotation: [";
+  const Mat3 R = c.T_imu_lidar.rotation();
+  for (int i = 0; i < 9; ++i) e << (i > 0 ? ", " : "") << R(i / 3, i % 3);
+  const Vec3 p = c.T_imu_lidar.translation();
+  e << "]\n  translation: [" << p.x() << ", " << p.y() << ", " << p.z() << "]\n";
+  io::CloseChecked(e, path);
+  return true;
+}
+
+}  // namespace ctlio::lioapp

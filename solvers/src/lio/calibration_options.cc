@@ -1,0 +1,27 @@
+// The calibration options' checks (the config parsers and the YAML fuzz target link this alone).
+#include "ctlio/solvers/lio/calibration_options.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ctlio::lio {
+
+void CalibrationOptions::Validate() const {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("OdometryConfig: ") + what);
+  };
+  for (double d : time_offset_s) {
+    // A clock offset beyond a second is a wrong stamp base, not something to estimate.
+    require(std::isfinite(d) && std::abs(d) <= 1.0,
+            "calibration.time_offset_s must be in [-1, 1] s");
+  }
+  require(std::isfinite(time_offset_prior_sigma_s) && time_offset_prior_sigma_s > 0,
+          "calibration.time_offset_prior_sigma_s must be positive");
+  require(std::isfinite(extrinsic_prior_sigma_deg) && extrinsic_prior_sigma_deg > 0,
+          "calibration.extrinsic_prior_sigma_deg must be positive");
+  require(std::isfinite(extrinsic_prior_sigma_m) && extrinsic_prior_sigma_m > 0,
+          "calibration.extrinsic_prior_sigma_m must be positive");
+}
+
+}  // namespace ctlio::lio
