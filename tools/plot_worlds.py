@@ -6,7 +6,9 @@ above the bars ("3/10 failed"), a cell where every run failed gets an "x" at the
 
 usage: plot_worlds.py <output.png> <dir> [<dir> ...]
 Each <dir> is a ctlio_experiment output folder (a job or a --merge of jobs) with settings.txt
-(its "world" line), pooled.csv and results.csv. Exit code 3 if matplotlib is missing.
+(its "world" and "config" lines), pooled.csv and results.csv. The first folder's config is the
+main one: the methods of a folder run with another config are shown as "method [config]".
+Exit code 3 if matplotlib is missing.
 """
 import csv
 import math
@@ -25,16 +27,25 @@ except ImportError:
 
 COLOURS = {"singer_lio": "#d62728", "imu_input": "#1f77b4", "lidar_gyro": "#2ca02c",
            "lidar_only": "#9467bd"}
+EXTRA_COLOURS = ["#17becf", "#8c564b", "#e377c2", "#7f7f7f"]
 
 
-def read_folder(folder):
-    """Returns [(cell label, method, pooled row, median of the runs' median CPU ms)]."""
-    world = "?"
+def read_settings(folder):
+    settings = {}
     with open(os.path.join(folder, "settings.txt")) as f:
         for line in f:
             key, _, value = line.strip().partition(" ")
-            if key == "world":
-                world = value
+            settings[key] = value
+    return settings
+
+
+def read_folder(folder, main_config):
+    """Returns [(cell label, method, pooled row, median of the runs' median CPU ms)]; a method
+    run with another config than main_config is named "method [config]"."""
+    settings = read_settings(folder)
+    world = settings.get("world", "?")
+    config = settings.get("config", "")
+    suffix = "" if config == main_config else " [" + os.path.splitext(config)[0] + "]"
     cpu = {}
     with open(os.path.join(folder, "results.csv")) as f:
         for row in csv.DictReader(f):
@@ -51,7 +62,7 @@ def read_folder(folder):
                 label += " / " + row["scenario"]
             # The same statistic as table.md's "median CPU ms/scan" (median over the runs).
             median_cpu = statistics.median(cpu[key]) if key in cpu else math.nan
-            cells.append((label, row["method"], row, median_cpu))
+            cells.append((label, row["method"] + suffix, row, median_cpu))
     return cells
 
 
@@ -60,16 +71,26 @@ def main():
         sys.stderr.write(__doc__)
         return 2
     out = sys.argv[1]
+    # The config of the first folder is the main one; others mark their methods.
+    main_config = read_settings(sys.argv[2]).get("config", "")
     rows = []
     for folder in sys.argv[2:]:
-        rows += read_folder(folder)
+        rows += read_folder(folder, main_config)
     labels, methods = [], []
     for label, method, _, _ in rows:
         if label not in labels:
             labels.append(label)
         if method not in methods:
             methods.append(method)
+    # Variants of a method (another config) next to it.
+    base = list(COLOURS)
+    methods.sort(key=lambda m: (base.index(m.split(" ")[0]) if m.split(" ")[0] in base
+                                else len(base), m))
     by_key = {(label, method): (row, cpu) for label, method, row, cpu in rows}
+    colours = dict(COLOURS)
+    for method in methods:
+        if method not in colours:
+            colours[method] = EXTRA_COLOURS[len(colours) % len(EXTRA_COLOURS)]
 
     fig, axes = plt.subplots(3, 1, figsize=(max(8, 1.1 * len(labels) + 2), 11), sharex=True)
     width = 0.8 / len(methods)
@@ -93,16 +114,16 @@ def main():
                 v = value(row, cpu)
                 failures, runs = int(row["failures"]), int(row["runs"])
                 if math.isfinite(v) and v > 0:
-                    ax.bar(x, v, width, color=COLOURS.get(method, "grey"))
+                    ax.bar(x, v, width, color=colours[method])
                 elif ax is not axes[2]:
-                    ax.plot(x, top * 1.5, "x", color=COLOURS.get(method, "grey"))
+                    ax.plot(x, top * 1.5, "x", color=colours[method])
                 if ax is axes[0] and failures > 0:
                     y = v if math.isfinite(v) and v > 0 else top * 1.5
                     ax.text(x, y * 1.2, "%d/%d failed" % (failures, runs), rotation=90,
                             ha="center", va="bottom", fontsize=7)
         if ax is not axes[2]:
             ax.set_ylim(top=top * 40)
-    handles = [matplotlib.patches.Patch(color=COLOURS.get(m, "grey"), label=m) for m in methods]
+    handles = [matplotlib.patches.Patch(color=colours[m], label=m) for m in methods]
     axes[0].legend(handles=handles, ncol=len(methods), fontsize=8, loc="upper left")
     axes[0].set_title("worlds x regimes: x = every run failed; failed runs are not in ATE/drift")
     axes[-1].set_xticks(range(len(labels)))
