@@ -52,6 +52,7 @@
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/yaml_io.h"
+#include "lio/calibration_output.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
@@ -109,6 +110,15 @@ DEFINE_string(sim_extrinsic_error, "",
               "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
               "drawn per --sim_index when omitted; apps/sim extrinsic_error.h); the final "
               "extrinsic error is reported against the truth");
+DEFINE_double(sim_imu_stamp_offset, 0.0,
+              "--format sim: IMU 0's samples of the motion at t are stamped t - this [s] (the "
+              "clock offset the online calibration should find; other IMUs: stamp_offset= in "
+              "--sim_imus)");
+DEFINE_bool(estimate_time_offset, false,
+            "Estimate each IMU's clock offset online (calibration.estimate_time_offset)");
+DEFINE_string(time_offset, "",
+              "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
+              "mean when estimated, else applied as given");
 DEFINE_string(sim_imu_dropout, "",
               "--format sim: IMU outages start:length[,start:length...] in seconds since the "
               "sequence start (samples inside are absent), e.g. 5:1");
@@ -135,6 +145,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     given.beams = Given("sim_beams", FLAGS_sim_beams);
     sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
+    c.imu.stamp_offset_s = FLAGS_sim_imu_stamp_offset;
     c.extra_imus = sim::ParseImuSpecs(FLAGS_sim_imus, c.imu);
     const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_sim_extrinsic_error);
     if (!extrinsic_error.IsZero()) {
@@ -197,7 +208,14 @@ bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& 
   if (python.empty()) return false;
   std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
   for (const std::string& f : folders) cmd += " '" + f + "'";
-  return std::system((cmd + " >/dev/null").c_str()) == 0;
+  bool ok = std::system((cmd + " >/dev/null").c_str()) == 0;
+  // The online calibration's estimates and ±3σ over time (calibration.png per method folder).
+  for (const std::string& f : folders) {
+    if (!std::filesystem::exists(f + "/calibration.csv")) continue;
+    const std::string c = python + " '" + CTLIO_TOOLS_DIR + "/plot_calibration.py' '" + f + "'";
+    ok = std::system((c + " >/dev/null").c_str()) == 0 && ok;
+  }
+  return ok;
 }
 
 std::vector<std::string> Split(const std::string& s) {
@@ -278,6 +296,13 @@ int main(int argc, char** argv) {
         config.frontend.threads = FLAGS_frontend_threads;
       }
       if (!FLAGS_association.empty()) config.frontend.association = FLAGS_association;
+      if (FLAGS_estimate_time_offset) config.calibration.estimate_time_offset = true;
+      if (!FLAGS_time_offset.empty()) {
+        config.calibration.time_offset_s.clear();
+        for (const std::string& d : Split(FLAGS_time_offset)) {
+          config.calibration.time_offset_s.push_back(std::stod(d));
+        }
+      }
       config.Validate();
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
@@ -355,6 +380,25 @@ int main(int argc, char** argv) {
         truths.push_back(*source->GroundTruth());
       } else {
         truths.emplace_back();
+      }
+      if (config.calibration.any()) {
+        lioapp::WriteCalibrationLog(out + "/calibration.csv", run);
+        lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run);
+        if (const lio::ScanResult* last = lioapp::LastCalibration(run)) {
+          const auto& c = last->calibration;
+          for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+            ev << "imu" << j << "_time_offset_s " << std::setprecision(9) << c.time_offset_s[j]
+               << "\nimu" << j << "_time_offset_sigma_s "
+               << (j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN) << "\n";
+            if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
+              ev << "imu" << j << "_time_offset_true_s " << *run.true_time_offsets[j] << "\nimu"
+                 << j << "_time_offset_error_s " << c.time_offset_s[j] - *run.true_time_offsets[j]
+                 << "\n";
+            }
+          }
+          ev << std::setprecision(6);
+          // (The extrinsic's lines follow here.)
+        }
       }
       if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
       folders.push_back(out);

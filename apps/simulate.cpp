@@ -56,6 +56,10 @@ DEFINE_string(imus, "",
               "Further IMUs (IMU 1, 2, ...), ';'-separated key=value lists: rate, xyz, rpy, "
               "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage (apps/sim "
               "imu_specs.h), e.g. rate=400,xyz=0.3:0:0,offset=0.0013");
+DEFINE_double(imu_stamp_offset, 0.0,
+              "IMU 0's sample of the motion at t is stamped t - this [s] (a clock offset for the "
+              "odometry's online calibration; recorded as true_time_offset_s in ctlio_sim.yaml; "
+              "other IMUs: stamp_offset= in --imus)");
 DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second (Poisson); 0 = none");
 DEFINE_double(imu_outage_min, 0.1, "Shortest random IMU outage [s]");
 DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
@@ -160,6 +164,7 @@ int main(int argc, char** argv) {
     I.accel_limit = FLAGS_accel_limit;
     I.gyro_limit = FLAGS_gyro_limit;
     I.outages = sim::ParseImuOutages(FLAGS_imu_dropout);
+    I.stamp_offset_s = FLAGS_imu_stamp_offset;
     I.outage_rate = FLAGS_imu_outage_rate;
     I.outage_length_min = FLAGS_imu_outage_min;
     I.outage_length_max = FLAGS_imu_outage_max;

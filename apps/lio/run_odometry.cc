@@ -321,7 +321,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
     if (config.pose_covariance) PoseNees(run.scans, *truth, T_imu_lidar, &run);
   }
-  for (const io::ImuInfo& info : source.Imus()) run.true_biases.push_back(info.true_bias);
+  for (const io::ImuInfo& info : source.Imus()) {
+    run.true_biases.push_back(info.true_bias);
+    run.true_time_offsets.push_back(info.true_time_offset_s);
+  }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
   return run;

@@ -76,6 +76,9 @@ struct RunSummary {
   // initial biases where the source knows them (simulator).
   std::vector<Vec6> final_biases;
   std::vector<std::optional<Vec6>> true_biases;
+  // The true clock offset of every IMU where the source knows it (simulator's stamp_offset), to
+  // compare the online calibration's estimate with (ScanResult::calibration).
+  std::vector<std::optional<double>> true_time_offsets;
   // Consistency (config.pose_covariance and ground truth): per estimated scan after the first,
   // the NEES of the pose, ε = Log(T_mr,true·T_mr⁻¹), εᵀΣ⁻¹ε (6 if consistent), and of its
   // translation and rotation parts alone (3 each), with T_mr,true anchored at the first scan.

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -534,6 +535,83 @@ TEST(GpInterpolatorTest, AccelerationVersusDerivativeOfVelocity) {
   EXPECT_LT(worst_fixed_axis, 1e-6);
   EXPECT_GT(worst_general, 1e-4);
   EXPECT_LT(worst_general, 0.02);
+}
+
+// ẋ(τ) = d[δT; δϖ; δϖ̇]/dτ (StateRows' rate, from Λ'(τ), Ω'(τ)) against central differences of
+// the interpolated state over τ, on every case (incl. α·Δt → 0, small angles, near the Singer
+// series switch, |φ| near π), at interior τ and at both ends, for the full rows and a subset.
+TEST(GpInterpolatorTest, StateRateMatchesCentralDifferences) {
+  std::mt19937 rng(71);
+  for (const Case& c : Cases()) {
+    Vec6 qc;
+    qc << 1, 2, 3, 4, 5, 6;
+    const SingerModel<6> model(qc, c.alpha);
+    for (int trial = 0; trial < 3; ++trial) {
+      const Knots K = MakeKnots(rng, c);
+      const double t0 = 3.0, t1 = t0 + c.dt;
+      for (const double f : {0.0, c.frac, 1.0}) {
+        const double tau = t0 + f * c.dt;
+        const GpInterpolator interp(model, t0, t1, tau, /*with_time_derivative=*/true);
+        KnotState x;
+        StateRate rate = StateRate::Constant(std::nan(""));
+        interp.StateRows(K.k, K.k1, kAllStateRows, &x, nullptr, nullptr, &rate);
+        // Central differences inside; at the ends (the interpolation is defined on [t_k, t_{k+1}]
+        // only) the second-order one-sided formula (4(f(h) − f(0)) − (f(2h) − f(0)))/2h.
+        const double h = 1e-6 * c.dt;
+        const auto at = [&](double t) {
+          KnotState y;
+          GpInterpolator(model, t0, t1, t).State(K.k, K.k1, &y, nullptr, nullptr);
+          return y;
+        };
+        const auto diff = [](const KnotState& a, const KnotState& b) {  // a − b
+          StateRate d;
+          d << (a.pose * b.pose.Inverse()).Log(), a.velocity - b.velocity,
+              a.acceleration - b.acceleration;
+          return d;
+        };
+        StateRate numeric;
+        if (f > 0.0 && f < 1.0) {
+          numeric = diff(at(tau + h), at(tau - h)) / (2 * h);
+        } else {
+          const double sgn = f == 0.0 ? 1.0 : -1.0;
+          numeric =
+              sgn * (4.0 * diff(at(tau + sgn * h), x) - diff(at(tau + 2 * sgn * h), x)) / (2 * h);
+        }
+        const double scale = std::max(1.0, rate.norm());
+        EXPECT_LT((rate - numeric).norm() / scale, 1e-5)
+            << c.name << " f=" << f << "\nanalytic " << rate.transpose() << "\nnumeric  "
+            << numeric.transpose();
+        // The pose rows are ϖ(τ) (T(τ+h) ≈ Exp(hϖ)T(τ)).
+        EXPECT_LT((rate.head<6>() - x.velocity).norm(), 1e-9 * scale) << c.name;
+        // A subset of rows: the same values, other rows untouched.
+        StateRate part = StateRate::Constant(7.0);
+        const unsigned rows = kAngularVelocityRows | kLinearAccelerationRows;
+        interp.StateRows(K.k, K.k1, rows, nullptr, nullptr, nullptr, &part);
+        EXPECT_TRUE(part.segment<3>(9).isApprox(rate.segment<3>(9), 1e-12)) << c.name;
+        EXPECT_TRUE(part.segment<3>(12).isApprox(rate.segment<3>(12), 1e-12)) << c.name;
+        EXPECT_EQ(part.head<9>(), StateRate::Constant(7.0).head<9>());
+        EXPECT_EQ(part.tail<3>(), StateRate::Constant(7.0).tail<3>());
+        // Λ'(τ)'s and Ω'(τ)'s first two block rows are Λ's and Ω's next ones (γ's own rates).
+        for (int j = 0; j < 3; ++j) {
+          for (int r = 0; r < 2; ++r) {
+            const auto& ld = interp.LambdaDot().block(r, j);
+            const auto& l = interp.Lambda().block(r + 1, j);
+            const auto& od = interp.OmegaDot().block(r, j);
+            const auto& o = interp.Omega().block(r + 1, j);
+            EXPECT_LT((ld - l).abs().maxCoeff(), 1e-9 * (1.0 + l.abs().maxCoeff())) << c.name;
+            EXPECT_LT((od - o).abs().maxCoeff(), 1e-9 * (1.0 + o.abs().maxCoeff())) << c.name;
+          }
+        }
+      }
+    }
+  }
+  // Without with_time_derivative, asking for the rate is an error.
+  const SingerModel<6> model = LioModel();
+  StateRate rate;
+  KnotState k;
+  EXPECT_THROW(GpInterpolator(model, 0.0, 0.1, 0.05)
+                   .StateRows(k, k, kAllStateRows, nullptr, nullptr, nullptr, &rate),
+               std::runtime_error);
 }
 
 }  // namespace

@@ -161,6 +161,7 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
           b << ba[0], ba[1], ba[2], bg[0], bg[1], bg[2];
           info.true_bias = b;
         }
+        if (n["true_time_offset_s"]) info.true_time_offset_s = n["true_time_offset_s"].as<double>();
         imus_.push_back(info);
         imu_files.push_back(file);
       }
@@ -286,6 +287,9 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
           << std::vector<double>{b[0], b[1], b[2]};
         y << YAML::Key << "gyro_bias" << YAML::Value << YAML::Flow
           << std::vector<double>{b[3], b[4], b[5]};
+      }
+      if (info.true_time_offset_s) {
+        y << YAML::Key << "true_time_offset_s" << YAML::Value << *info.true_time_offset_s;
       }
       y << YAML::EndMap;
     }

@@ -50,6 +50,7 @@ std::vector<ImuConfig> ParseImuSpecs(const std::string& text, const ImuConfig& f
     c.outage_rate = 0.0;
     c.body_from_imu = SE3();
     c.clock_offset_s = 0.0;
+    c.stamp_offset_s = 0.0;
     Vec3 xyz = Vec3::Zero(), rpy_deg = Vec3::Zero();
     const std::string imu = "IMU " + std::to_string(out.size() + 1) + " ('" + spec + "')";
     for (const std::string& kv : SplitOn(spec, ',')) {
@@ -68,6 +69,9 @@ std::vector<ImuConfig> ParseImuSpecs(const std::string& text, const ImuConfig& f
       } else if (key == "offset") {
         c.clock_offset_s = Number(value, where);
         if (c.clock_offset_s < 0) throw std::runtime_error(where + ": must be >= 0");
+      } else if (key == "stamp_offset") {
+        c.stamp_offset_s = Number(value, where);
+        if (std::abs(c.stamp_offset_s) > 1.0) throw std::runtime_error(where + ": |δ| > 1 s");
       } else if (key == "accel_noise") {
         c.accel_noise = Number(value, where);
       } else if (key == "gyro_noise") {
@@ -82,9 +86,10 @@ std::vector<ImuConfig> ParseImuSpecs(const std::string& text, const ImuConfig& f
           c.outages.insert(c.outages.end(), parsed.begin(), parsed.end());
         }
       } else {
-        throw std::runtime_error(where +
-                                 ": unknown key (rate, xyz, rpy, offset, accel_noise, "
-                                 "gyro_noise, accel_bias, gyro_bias, outage)");
+        throw std::runtime_error(
+            where +
+            ": unknown key (rate, xyz, rpy, offset, stamp_offset, accel_noise, "
+            "gyro_noise, accel_bias, gyro_bias, outage)");
       }
     }
     if (c.accel_noise < 0 || c.gyro_noise < 0) {

@@ -112,6 +112,7 @@ void LidarInertialSim::GenerateImu(size_t j) {
        t_ns += dt_ns) {
     io::ImuSample s = mounted ? TrueImu(Seconds(t_ns), I.body_from_imu) : TrueImu(Seconds(t_ns));
     s.imu = int(j);
+    if (I.stamp_offset_s != 0.0) s.t_ns -= std::llround(I.stamp_offset_s * 1e9);
     if (!I.accel_scale.isZero()) s.accel = s.accel.cwiseProduct(Vec3::Ones() + I.accel_scale);
     if (!I.gyro_scale.isZero()) s.gyro = s.gyro.cwiseProduct(Vec3::Ones() + I.gyro_scale);
     for (int k = 0; k < 3; ++k) {
@@ -374,6 +375,7 @@ std::vector<io::ImuInfo> SimulatedSource::Imus() const {
     Vec6 b;
     b << I.accel_bias, I.gyro_bias;
     info.true_bias = b;
+    if (I.stamp_offset_s != 0.0) info.true_time_offset_s = I.stamp_offset_s;
     out.push_back(info);
   }
   return out;

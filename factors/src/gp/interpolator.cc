@@ -164,10 +164,14 @@ Eigen::Matrix<double, N, 6> RowsTimesDiag(const OutputMap& M, int L, int h, cons
 //   ∂/∂δT_{k+1} = (B_0 + B_1·D1 + B_2·D2)·J⁻¹,  ∂/∂ϖ_{k+1} = B_1·J⁻¹ + B_2·E,
 //   ∂/∂ϖ̇_{k+1} = B_2·J⁻¹,  ∂/∂δT_k = −∂/∂δT_{k+1}·Ad21 (+ Ad(Exp ξ) on the pose rows),
 //   ∂/∂ϖ_k = Σ_r M_{Lr}·diag(Λ_r1),  ∂/∂ϖ̇_k = Σ_r M_{Lr}·diag(Λ_r2).
+// With `rate` (and Λ', Ω' in `dot`), also rows of ẋ(τ) = M·(Λ'γ_k + Ω'γ_{k+1}) (interpolator.h).
 void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& omega,
                   const KnotState& k, const KnotState* k1, const LocalVariables* shared,
-                  unsigned rows, KnotState* x, StateJacobian* J_k, StateJacobian* J_k1) {
+                  unsigned rows, KnotState* x, StateJacobian* J_k, StateJacobian* J_k1,
+                  const AxisBlockMatrix<6>* lambda_dot = nullptr,
+                  const AxisBlockMatrix<6>* omega_dot = nullptr, StateRate* rate = nullptr) {
   const bool jac = (J_k != nullptr || J_k1 != nullptr) && (rows & kAllStateRows) != 0;
+  const bool with_rate = rate != nullptr && (rows & kAllStateRows) != 0;
   std::optional<LocalVariables> own;
   const LocalVariables& lv = shared != nullptr ? *shared : own.emplace(k, *k1, jac);
   Vec6 g[3];
@@ -190,7 +194,7 @@ void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& om
     x->velocity = vel;
     x->acceleration.noalias() = M.J * v;
   }
-  if (!jac) return;
+  if (!jac && !with_rate) return;
   const int top_layer = (rows & 48u) != 0 ? 2 : (rows & 12u) != 0 ? 1 : 0;
   if (top_layer == 1) {
     M.M21 = LeftJacobianVectorDerivative(xi, g[1]);
@@ -219,9 +223,32 @@ void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& om
       acc_rows(std::integral_constant<int, 3>(), m == 1u ? 0 : 3);
     }
   }
+  // dγ(τ)/dτ = Λ'γ_k + Ω'γ_{k+1} (γ_k = [0; ϖ_k; ϖ̇_k]).
+  Vec6 dg[3];
+  if (with_rate) {
+    for (int q = 0; q < 3; ++q) {
+      dg[q] = (lambda_dot->block(q, 1) * k.velocity.array() +
+               lambda_dot->block(q, 2) * k.acceleration.array() +
+               omega_dot->block(q, 0) * lv.gamma[0].array() +
+               omega_dot->block(q, 1) * lv.gamma[1].array() +
+               omega_dot->block(q, 2) * lv.gamma[2].array())
+                  .matrix();
+    }
+  }
   const auto range = [&](int L, auto n, int h) {
     constexpr int N = decltype(n)::value;
     const int r = 6 * L + h;
+    if (with_rate) {
+      // Rows of M·dγ/dτ, layer L: Σ_q M_{Lq}·dγ_q.
+      auto out = rate->template segment<N>(r);
+      out.noalias() = M.J.middleRows<N>(h) * dg[L];
+      if (L == 1) out.noalias() += M.M21.middleRows<N>(h) * dg[0];
+      if (L == 2) {
+        out.noalias() += M.M31.middleRows<N>(h) * dg[0];
+        out.noalias() += M.M32.middleRows<N>(h) * dg[1];
+      }
+    }
+    if (!jac) return;
     const auto col = [&](const AxisBlockMatrix<6>& A, int c) {
       return RowsTimesDiag<N>(M, L, h, A.block(0, c), A.block(1, c), A.block(2, c));
     };
@@ -262,7 +289,8 @@ void EvaluateRows(const AxisBlockMatrix<6>& lambda, const AxisBlockMatrix<6>& om
 
 }  // namespace
 
-GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau) {
+GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau,
+                               bool with_time_derivative) {
   if (!(t_k1 > t_k) || !(tau >= t_k) || !(tau <= t_k1)) {
     Throw(__LINE__,
           "GpInterpolator needs t_k < t_k1 and t_k <= tau <= t_k1, got t_k=" + std::to_string(t_k) +
@@ -270,7 +298,9 @@ GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t
   }
   const double d1 = tau - t_k, d2 = t_k1 - tau, dT = t_k1 - t_k;
   const auto& alpha = model.alpha();
-  Eigen::Matrix3d L, O;
+  Eigen::Matrix3d L, O, Ld, Od;
+  std::shared_ptr<Rates> rates;
+  if (with_time_derivative) rates = std::make_shared<Rates>();
   for (int i = 0; i < 6; ++i) {
     if (i == 0 || alpha[i] != alpha[i - 1]) {
       // Qc cancels in Ω and Λ, so the dimensionless shapes with Qc = 1 suffice.
@@ -289,10 +319,27 @@ GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t
       const Eigen::Matrix3d Phi1 =
           SingerModel<6>::ShapeTransition(EvaluateSingerShape(alpha[i] * d1), d1);
       L = Phi1 - O * PhiT;
+      if (rates) {
+        // Ω' = AΩ + e₃e₃ᵀΦ(t_{k+1}−τ)ᵀQ(T)⁻¹, Λ' = AΦ(τ−t_k) − Ω'Φ(T) (header; Qc = 1).
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        A(0, 1) = 1.0;
+        A(1, 2) = 1.0;
+        A(2, 2) = -alpha[i];
+        const Eigen::Matrix3d Phi2 =
+            SingerModel<6>::ShapeTransition(EvaluateSingerShape(alpha[i] * d2), d2);
+        Od = A * O;
+        Od.row(2) += (Phi2.transpose() * W.transpose() * W).row(2);
+        Ld = A * Phi1 - Od * PhiT;
+      }
     }
     lambda_.SetAxis(i, L);
     omega_.SetAxis(i, O);
+    if (rates) {
+      rates->lambda_dot.SetAxis(i, Ld);
+      rates->omega_dot.SetAxis(i, Od);
+    }
   }
+  rates_ = std::move(rates);
 }
 
 void GpInterpolator::Pose(const KnotState& k, const KnotState& k1, SE3* T, PoseJacobian* J_k,
@@ -321,6 +368,15 @@ void GpInterpolator::StateRows(const KnotState& k, const KnotState& k1, unsigned
 void GpInterpolator::StateRows(const KnotState& k, const LocalVariables& local, unsigned rows,
                                KnotState* x, StateJacobian* J_k, StateJacobian* J_k1) const {
   EvaluateRows(lambda_, omega_, k, nullptr, &local, rows, x, J_k, J_k1);
+}
+
+void GpInterpolator::StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
+                               StateJacobian* J_k, StateJacobian* J_k1, StateRate* rate) const {
+  if (rate != nullptr && !rates_) {
+    Throw(__LINE__, "GpInterpolator::StateRows: the rate needs with_time_derivative");
+  }
+  EvaluateRows(lambda_, omega_, k, &k1, nullptr, rows, x, J_k, J_k1,
+               rates_ ? &rates_->lambda_dot : nullptr, rates_ ? &rates_->omega_dot : nullptr, rate);
 }
 
 void GpInterpolator::PoseAt(const KnotState& k, const LocalVariables& local, PoseAtTau* out) const {

@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/gp/singer_prior.h"
+#include "ctlio/factors/imu/imu_accel_time_offset.h"
+#include "ctlio/factors/imu/imu_gyro_time_offset.h"
 #include "ctlio/factors/imu/imu_measurement.h"
+#include "ctlio/factors/priors/euclidean_prior.h"
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
@@ -20,6 +25,19 @@ GpKnotEstimator::GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& 
   for (int j = 0; j < config_.num_imus(); ++j) {
     mountings_.push_back(imu::ImuMounting::FromPose(config_.ImuPose(j)));
   }
+  const CalibrationOptions& cal = config_.calibration;
+  time_offsets_ = cal.estimate_time_offset;
+  for (double d : cal.time_offset_s) time_offsets_ = time_offsets_ || d != 0.0;
+  if (!cal.time_offset_s.empty() && static_cast<int>(cal.time_offset_s.size()) < num_imus()) {
+    throw std::invalid_argument(
+        "calibration.time_offset_s: " + std::to_string(cal.time_offset_s.size()) + " values for " +
+        std::to_string(num_imus()) + " IMUs");
+  }
+}
+
+double GpKnotEstimator::TimeOffset(int imu, const SlidingWindow& window) const {
+  return config_.calibration.estimate_time_offset ? window.State(TimeOffsetKey(imu))[0]
+                                                  : config_.calibration.TimeOffset(imu);
 }
 
 GpKnotEstimator::Knot GpKnotEstimator::AddKnot(double t, const SE3& T_rm, const Vec6& w,
@@ -68,6 +86,12 @@ SE3 GpKnotEstimator::PreviousPose() const {
 
 void GpKnotEstimator::Report(ScanResult* result) const {
   const Knot& k = knots_.back();
+  if (time_offsets() && config_.calibration.estimate_time_offset && window_ != nullptr) {
+    result->calibration.time_offset_s.clear();
+    for (int j = 0; j < num_imus(); ++j) {
+      result->calibration.time_offset_s.push_back(TimeOffset(j, *window_));
+    }
+  }
   result->T_mr = PoseManifold::Pose(k.pose).Inverse();
   // ϖ is minus the body twist [v; ω] in the robot frame (SPEC §1).
   result->velocity = -Eigen::Map<const Vec6>(k.velocity);
@@ -114,6 +138,23 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
   for (int j = 0; j < num_imus(); ++j) {
     window->AddResidualBlock(MakeInitialBiasPrior(config_), nullptr, {k.keys.Bias(j)});
   }
+  window_ = window;
+  if (time_offsets()) {
+    const CalibrationOptions& cal = config_.calibration;
+    for (int j = 0; j < num_imus(); ++j) {
+      // Samples stamped up to t_0 − δ_j measure the state before the first knot.
+      last_stamp_.push_back(scan.t_end - cal.TimeOffset(j));
+      if (!cal.estimate_time_offset) continue;
+      // δ_j: a static 1-D state with its prior N(δ̄_j, σ²), added once (the marginal priors
+      // carry its information on when knots leave).
+      const Eigen::VectorXd mean = Eigen::VectorXd::Constant(1, cal.TimeOffset(j));
+      window->AddVectorState(TimeOffsetKey(j), mean);
+      window->AddResidualBlock(
+          new EuclideanPrior<1>(Eigen::Matrix<double, 1, 1>(mean[0]),
+                                Eigen::Matrix<double, 1, 1>(1.0 / cal.time_offset_prior_sigma_s)),
+          nullptr, {TimeOffsetKey(j)});
+    }
+  }
 }
 
 void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
@@ -121,7 +162,17 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
   const Knot prev = knots_.back();
   const double dt = scan.t_end - prev.t;
   std::vector<std::vector<ImuSample>> imu(num_imus());
-  for (int j = 0; j < num_imus(); ++j) imu[j] = imu_.Samples(prev.t, scan.t_end, j);
+  for (int j = 0; j < num_imus(); ++j) {
+    if (time_offsets()) {
+      // The samples whose t + δ̄_j falls into (t_prev, t_end], following on from the stamps
+      // already taken (δ̄_j moves between scans; no sample twice, none skipped).
+      const double until = std::max(last_stamp_[j], scan.t_end - TimeOffset(j, *window));
+      imu[j] = imu_.Samples(last_stamp_[j], until, j);
+      last_stamp_[j] = until;
+    } else {
+      imu[j] = imu_.Samples(prev.t, scan.t_end, j);
+    }
+  }
 
   // Initial guess: constant body velocity from the previous knot; with a gyro, the newest
   // sample (of the first IMU that has one) gives the angular part (ϖ_φ = −C_ri(ω_meas − b_g),
@@ -167,6 +218,46 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
   bool accel_loss_used = false;
   const gp::KnotBlocks knots = {prev.pose, prev.velocity, prev.acceleration,
                                 k.pose,    k.velocity,    k.acceleration};
+  if (time_offsets()) {
+    const double delta = TimeOffset(imu_index, *window);
+    for (const ImuSample& s : imu) {
+      const double stamp = imu_.Seconds(s.t_ns);
+      if (config_.calibration.estimate_time_offset) {
+        std::vector<StateId> g = gyro_states, a = accel_states;
+        g.push_back(TimeOffsetKey(imu_index));
+        a.push_back(TimeOffsetKey(imu_index));
+        window->AddResidualBlock(new imu::ImuGyroMeasurementWithTimeOffset(
+                                     model_, prev.t, k.t, stamp, s.gyro, gyro_cov, mounting),
+                                 nullptr, g);
+        ++result->imu_residuals;
+        if (config_.method == LioMethod::kSingerLio) {
+          window->AddResidualBlock(new imu::ImuAccelMeasurementWithTimeOffset(
+                                       model_, prev.t, k.t, stamp, s.accel, accel_cov,
+                                       config_.gravity, accel_model, mounting),
+                                   accel_loss.get(), a);
+          accel_loss_used = accel_loss != nullptr;
+          ++result->imu_residuals;
+        }
+        continue;
+      }
+      // A configured offset, held: the fixed-time factors at t + δ (on the interval).
+      const double tau = std::clamp(stamp + delta, prev.t, k.t);
+      window->AddResidualBlock(
+          new imu::ImuGyroMeasurement(model_, prev.t, k.t, tau, s.gyro, gyro_cov, mounting),
+          nullptr, gyro_states);
+      ++result->imu_residuals;
+      if (config_.method == LioMethod::kSingerLio) {
+        window->AddResidualBlock(
+            new imu::ImuAccelMeasurement(model_, prev.t, k.t, tau, s.accel, accel_cov,
+                                         config_.gravity, accel_model, mounting),
+            accel_loss.get(), accel_states);
+        accel_loss_used = accel_loss != nullptr;
+        ++result->imu_residuals;
+      }
+    }
+    if (accel_loss_used) accel_loss.release();
+    return;
+  }
   for (const ImuSample& s : imu) {
     const double tau = imu_.Seconds(s.t_ns);
     // The sample's state at τ, interpolated once per evaluation for its gyro and accelerometer

@@ -224,6 +224,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
   if (config_.pose_covariance) ReportPoseCovariance(result);
+  if (config_.calibration.any()) ReportCalibrationCovariance(result);
   if (result->calibration.has_extrinsic) ReportExtrinsicCovariance(result);
 }
 
@@ -259,6 +260,30 @@ void LioOdometry::ReportPoseCovariance(ScanResult* result) {
   const Mat6 M = result->T_mr.Adjoint() * estimator_->NewestPoseTangentFromBody().inverse();
   result->pose_covariance = M * Mat6(block) * M.transpose();
   result->has_pose_covariance = true;
+}
+
+void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
+  // The calibration states in the window (the estimators that have them) and their tangent sizes.
+  std::vector<std::pair<StateId, int>> states;
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    if (window_.HasState(TimeOffsetKey(j))) states.emplace_back(TimeOffsetKey(j), 1);
+  }
+  // (The extrinsic's states are appended here.)
+  if (states.empty()) return;
+  ceres::Covariance covariance(ceres::Covariance::Options{});
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const auto& s : states) blocks.emplace_back(window_.State(s.first), window_.State(s.first));
+  const bool ok = covariance.Compute(blocks, &window_.problem());
+  // A rank-deficient window gives no σ (NaN) rather than a pseudo-inverse.
+  auto& cal = result->calibration;
+  cal.time_offset_sigma_s.clear();
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    if (!window_.HasState(TimeOffsetKey(j))) continue;
+    double var = std::nan("");
+    const double* x = window_.State(TimeOffsetKey(j));
+    if (ok) covariance.GetCovarianceBlockInTangentSpace(x, x, &var);
+    cal.time_offset_sigma_s.push_back(var >= 0.0 ? std::sqrt(var) : std::nan(""));
+  }
 }
 
 void LioOdometry::Slide(ScanResult* result) {

@@ -33,6 +33,9 @@ struct ImuInfo {
   double gyro_sigma = 0.0;   // rad/s
   // The true initial biases [b_a; b_g] when known (simulated data), for evaluation only.
   std::optional<Vec6> true_bias;
+  // The true clock offset δ when known (simulated data, for evaluation only): a sample stamped t
+  // measures the motion at t + δ (what the odometry's calibration.time_offset_s should find).
+  std::optional<double> true_time_offset_s;
 };
 
 // A timestamped pose. In ground truth it is T_world_lidar: the lidar frame's pose in a fixed world

@@ -133,6 +133,10 @@ struct ImuConfig {
   // the first sample after the sequence start [s] (samples at start + offset + k/rate).
   SE3 body_from_imu;
   double clock_offset_s = 0.0;
+  // Stamp offset δ [s]: the sample measuring the motion at t carries the stamp t − δ (an IMU clock
+  // δ behind the lidar's); δ is what the odometry's online time-offset calibration should find
+  // (recorded as the IMU's true_time_offset_s). 0: stamps are the true times.
+  double stamp_offset_s = 0.0;
 };
 
 struct SimConfig {

@@ -12,9 +12,19 @@
 //   dϖ(τ) = ∂(Jξ̇)/∂ξ dξ + J dξ̇,
 //   dϖ̇(τ) = [∂(Jv)/∂ξ + ½Jξ̇^⋏∂(Jξ̇)/∂ξ] dξ + ½J(ξ̇^⋏J − ϖ(τ)^⋏) dξ̇ + J dξ̈,  v = ξ̈ + ½ξ̇^⋏ϖ,
 // and dγ(τ) = Λdγ_k + Ωdγ_{k+1}. All exact (checked against numeric differentiation).
+//
+// Time derivative (for a measurement whose time τ = t + δ depends on an estimated clock offset δ):
+// with A the per-axis Singer drift [[0, 1, 0], [0, 0, 1], [0, 0, −α]] and, Qc = 1 since it
+// cancels, dΦ(τ−t_k)/dτ = AΦ, dQ(τ−t_k)/dτ = AQ + QAᵀ + e₃e₃ᵀ, dΦ(t_{k+1}−τ)/dτ = −Φ(t_{k+1}−τ)A:
+//   Ω' = AΩ + e₃e₃ᵀΦ(t_{k+1}−τ)ᵀQ(T)⁻¹,  Λ' = AΦ(τ−t_k) − Ω'Φ(T),
+// so dγ(τ)/dτ = Λ'γ_k + Ω'γ_{k+1} = [ξ̇; ξ̈; ξ⃛] (the first two rows are γ's own, the third the
+// posterior mean of the jerk). The state's rate in the tangent [δT; δϖ; δϖ̇] of x(τ) is the
+// chain above applied to this variation: ẋ(τ) = M·dγ/dτ with M = [[J, 0, 0], [M21, J, 0],
+// [M31, M32, J]] (its pose rows are Jξ̇ = ϖ(τ), T(τ+h) ≈ Exp(hϖ)T(τ)).
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/gp/motion_model.h"
@@ -37,10 +47,14 @@ enum StateRowBlock : unsigned {
   kAllStateRows = (1u << 6) - 1,
 };
 
+using StateRate = Eigen::Matrix<double, 18, 1>;
+
 class GpInterpolator {
  public:
-  // Precomputes Λ(τ), Ω(τ). Requires t_k < t_k1 and t_k ≤ tau ≤ t_k1 (throws otherwise).
-  GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau);
+  // Precomputes Λ(τ), Ω(τ), and with `with_time_derivative` also Λ'(τ), Ω'(τ) (header) for
+  // StateRows' `rate`. Requires t_k < t_k1 and t_k ≤ tau ≤ t_k1 (throws otherwise).
+  GpInterpolator(const SingerModel<6>& model, double t_k, double t_k1, double tau,
+                 bool with_time_derivative = false);
 
   // T(τ) and ∂δT(τ)/∂[δT, δϖ, δϖ̇] of each knot (6×18); any output may be null.
   void Pose(const KnotState& k, const KnotState& k1, SE3* T, PoseJacobian* J_k,
@@ -63,6 +77,10 @@ class GpInterpolator {
             PoseJacobian* J_k1) const;
   void StateRows(const KnotState& k, const LocalVariables& local, unsigned rows, KnotState* x,
                  StateJacobian* J_k, StateJacobian* J_k1) const;
+  // As StateRows, and the rows `rows` of the state's time derivative ẋ(τ) = d[δT; δϖ; δϖ̇]/dτ
+  // (header) into *rate (other rows left as they were). Requires with_time_derivative.
+  void StateRows(const KnotState& k, const KnotState& k1, unsigned rows, KnotState* x,
+                 StateJacobian* J_k, StateJacobian* J_k1, StateRate* rate) const;
 
   // For residuals that read T(τ) through a row vector u = ∂e/∂δT(τ) (a point-to-plane error):
   // u·∂δT(τ)/∂knot costs a few 1×6 products when chained row-first,
@@ -87,9 +105,16 @@ class GpInterpolator {
 
   const AxisBlockMatrix<6>& Lambda() const { return lambda_; }
   const AxisBlockMatrix<6>& Omega() const { return omega_; }
+  // Λ'(τ), Ω'(τ); requires with_time_derivative.
+  const AxisBlockMatrix<6>& LambdaDot() const { return rates_->lambda_dot; }
+  const AxisBlockMatrix<6>& OmegaDot() const { return rates_->omega_dot; }
 
  private:
+  struct Rates {
+    AxisBlockMatrix<6> lambda_dot, omega_dot;
+  };
   AxisBlockMatrix<6> lambda_, omega_;
+  std::shared_ptr<const Rates> rates_;  // only with_time_derivative (keeps the default small)
 };
 
 // Prediction past the last knot k: γ(τ) = Φ(τ−t_k)γ_k (the GP mean given x_k only).

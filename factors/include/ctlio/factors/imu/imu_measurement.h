@@ -60,18 +60,10 @@
 #include "ctlio/factors/gp/motion_model.h"
 #include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/imu/imu_mounting.h"
+#include "ctlio/factors/imu/imu_residual.h"
 #include "ctlio/manifolds/types.h"
 
 namespace ctlio::imu {
-
-enum class AccelModel {
-  kBodyCentric,    // the paper's: ϖ̇_v as the body acceleration, no ω×v
-  kSpecificForce,  // exact specific force, with ω×v
-};
-
-// S with SᵀS = Σ⁻¹ (S = L⁻¹, Σ = LLᵀ); throws std::invalid_argument if Σ is
-// not positive definite.
-Mat3 SqrtInformation(const Mat3& covariance);
 
 class ImuGyroMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 6, 6, 6, 6> {
  public:
@@ -93,11 +85,7 @@ class ImuGyroMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 
  private:
   std::shared_ptr<const gp::SharedStateInterpolation> state_;
   double s_;  // (τ − t_k)/(t_{k+1} − t_k)
-  Vec3 gyro_;
-  Mat3 sqrt_information_;
-  Mat3 C_ir_;    // robot → IMU rotation
-  Mat3 S_C_ir_;  // S·C_ir
-  bool rotated_;
+  internal::GyroResidual residual_;
 };
 
 class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7, 6, 6, 6, 6, 4> {
@@ -119,21 +107,14 @@ class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7,
 
   // The state rows the residual reads (gp::StateRowBlock flags): δφ and ϖ̇_v, ϖ for the exact
   // model, ϖ_ω and ϖ̇_ω for a lever arm.
-  static unsigned Rows(AccelModel accel_model, const ImuMounting& mounting);
+  static unsigned Rows(AccelModel accel_model, const ImuMounting& mounting) {
+    return internal::AccelResidual::Rows(accel_model, mounting);
+  }
 
  private:
   std::shared_ptr<const gp::SharedStateInterpolation> state_;
   double s_;
-  Vec3 accel_;
-  Mat3 sqrt_information_;
-  Vec3 gravity_i_;
-  AccelModel accel_model_;
-  Mat3 C_ir_;    // robot → IMU rotation
-  Mat3 S_C_ir_;  // S·C_ir
-  bool rotated_;
-  Vec3 lever_arm_;  // p
-  bool lever_arm_nonzero_;
-  unsigned rows_;
+  internal::AccelResidual residual_;
 };
 
 }  // namespace ctlio::imu

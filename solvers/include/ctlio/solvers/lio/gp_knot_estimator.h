@@ -10,6 +10,12 @@
 // Online calibration (OdometryConfig::calibration.estimate_extrinsic): the extrinsic T_rl is a
 // static state (kExtrinsicKey) with a prior on the configured value, read by every lidar
 // residual (ContinuousPointToPlaneExtrinsic); the map points are placed with its estimate.
+// Clock offsets (OdometryConfig::calibration, Singer-LIO and lidar_gyro): IMU j's sample stamped
+// t measures the state at t + δ_j. Estimated: one 1-D block per IMU (TimeOffsetKey) with a
+// Gaussian prior, read by the time-offset IMU factors (imu_gyro_time_offset.h); a sample goes to
+// the interval that holds t + δ̄_j for the estimate δ̄_j when its knot is added (each sample once:
+// the stamps taken follow on from the previous interval's). Configured but not estimated: the
+// fixed-time factors at t + δ_j. Neither: the estimator without offsets, bit for bit.
 #pragma once
 
 #include <deque>
@@ -70,6 +76,9 @@ class GpKnotEstimator final : public Estimator {
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,
                           ScanResult* result) const;
+  // Clock offsets in use (estimated or configured non-zero), and IMU j's current δ_j.
+  bool time_offsets() const { return uses_imu() && time_offsets_; }
+  double TimeOffset(int imu, const SlidingWindow& window) const;
 
   OdometryConfig config_;
   const ImuBuffer& imu_;
@@ -78,6 +87,9 @@ class GpKnotEstimator final : public Estimator {
   std::deque<Knot> knots_;                   // oldest first
   double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
+  bool time_offsets_ = false;
+  std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
+  const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
 };
 
 }  // namespace ctlio::lio

@@ -92,6 +92,9 @@ class LioOdometry {
   // With calibration.estimate_extrinsic: the marginal σ of T_imu_lidar (ceres::Covariance of the
   // window) into result->calibration.extrinsic_sigma.
   void ReportExtrinsicCovariance(ScanResult* result);
+  // With online calibration: the marginal σ of the calibration states (ceres::Covariance of the
+  // window, as ReportPoseCovariance) into result->calibration.
+  void ReportCalibrationCovariance(ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;

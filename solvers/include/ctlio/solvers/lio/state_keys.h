@@ -17,6 +17,11 @@ inline constexpr StateId kGravityKey = -1;
 // estimate_extrinsic only: a static state like C_mi, never marginalised (calibration_options.h).
 inline constexpr StateId kExtrinsicKey = -2;
 
+// Static calibration states (calibration_options.h), like C_mi kept in the window and in the
+// marginal prior when knots leave. IMU j's clock offset δ_j [s] (1-D): −16 + j (j < 5); the ids
+// −2 … −11 are left to the other calibration states.
+inline StateId TimeOffsetKey(int imu) { return -16 + imu; }
+
 // A GP knot of Singer-LIO (SPEC §2, §3): pose T_rm, ϖ, ϖ̇ and the IMU biases [b_a; b_g], one
 // bias block per IMU: IMU j's is 8n + 3 + j (j < 5; `bias` is IMU 0's).
 struct KnotKeys {

@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""Plots the odometry's online calibration over time (calibration.csv of ctlio_odometry --out):
+each estimate with its ±3σ band, and the truth when calibration.yaml states one (simulator).
+
+Usage: plot_calibration.py FOLDER [FOLDER ...]   (writes FOLDER/calibration.png)
+"""
+import csv
+import math
+import os
+import re
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_columns(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return {}
+    header, data = rows[0], rows[1:]
+    cols = {h: [] for h in header}
+    for row in data:
+        for h, v in zip(header, row):
+            cols[h].append(float(v) if v not in ("", "nan", "-nan") else math.nan)
+    return cols
+
+
+def read_truth(folder):
+    """{imu index: true offset [s]} from calibration.yaml's comments (ctlio_odometry writes them)."""
+    truth = {}
+    path = os.path.join(folder, "calibration.yaml")
+    if not os.path.exists(path):
+        return truth
+    with open(path) as f:
+        for line in f:
+            m = re.match(r"# IMU (\d+): .*truth ([-+0-9.eE]+) ms", line)
+            if m:
+                truth[int(m.group(1))] = 1e-3 * float(m.group(2))
+    return truth
+
+
+def plot(folder):
+    cols = read_columns(os.path.join(folder, "calibration.csv"))
+    if "t_s" not in cols or not cols["t_s"]:
+        return
+    t0 = cols["t_s"][0]
+    t = [x - t0 for x in cols["t_s"]]
+    # One panel per estimated quantity: "<name>" with "<name>_sigma..." next to it.
+    series = []
+    for h in cols:
+        m = re.match(r"time_offset_(\d+)_s$", h)
+        if m:
+            series.append((f"IMU {m.group(1)} time offset [ms]", h,
+                           f"time_offset_{m.group(1)}_sigma_s", 1e3, int(m.group(1))))
+    # (Further calibration columns, e.g. the extrinsic's, are added to `series` here.)
+    if not series:
+        return
+    truth = read_truth(folder)
+    fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
+    for ax, (label, key, sigma_key, scale, imu) in zip(axes[:, 0], series):
+        est = [scale * v for v in cols[key]]
+        sig = [scale * v for v in cols.get(sigma_key, [math.nan] * len(est))]
+        ax.plot(t, est, color="tab:red", label="estimate")
+        lo = [e - 3 * s for e, s in zip(est, sig)]
+        hi = [e + 3 * s for e, s in zip(est, sig)]
+        ax.fill_between(t, lo, hi, color="tab:red", alpha=0.2, label="±3σ")
+        if imu in truth:
+            ax.axhline(scale * truth[imu], color="k", linestyle="--", label="truth")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+    axes[-1, 0].set_xlabel("time since the first scan [s]")
+    fig.suptitle(f"Online calibration: {os.path.basename(os.path.normpath(folder))}")
+    fig.tight_layout()
+    fig.savefig(os.path.join(folder, "calibration.png"), dpi=110)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    for folder in sys.argv[1:]:
+        plot(folder)
