@@ -47,8 +47,10 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
     if (extrinsic) {
       const Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
       const double deg = 180.0 / M_PI;
-      for (int i = 0; i < 3; ++i) f << ',' << d[i] << ',' << c.extrinsic_sigma[i];
-      for (int i = 3; i < 6; ++i) f << ',' << deg * d[i] << ',' << deg * c.extrinsic_sigma[i];
+      // No σ yet (the initialising scan, or a failed covariance): NaN, not a confident zero.
+      const Vec6 sigma = c.extrinsic_sigma.isZero() ? Vec6::Constant(NAN) : c.extrinsic_sigma;
+      for (int i = 0; i < 3; ++i) f << ',' << d[i] << ',' << sigma[i];
+      for (int i = 3; i < 6; ++i) f << ',' << deg * d[i] << ',' << deg * sigma[i];
     }
     f << "\n";
   }
@@ -75,9 +77,8 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run) {
       f << "\n";
     }
   }
-  f << "calibration:\n";
   if (!c.time_offset_s.empty()) {
-    f << "  time_offset_s: [";
+    f << "calibration:\n  time_offset_s: [";
     for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
       f << (j > 0 ? ", " : "") << c.time_offset_s[j];
     }

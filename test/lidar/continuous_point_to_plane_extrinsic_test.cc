@@ -12,24 +12,16 @@
 
 #include "common/gradient_check.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "lidar/random_association.h"
 
 namespace ctlio {
 namespace {
 
 using testing::JacobiansMatchNumeric;
 using testing::PoseParameters;
+using testing::RandomAssociation;
 using testing::RandomPose;
 using testing::RandomVec6;
-
-PlaneAssociation RandomAssociation(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  PlaneAssociation m;
-  m.point_robot = Vec3::Zero();  // not read by the factor
-  m.plane_point = 20.0 * Vec3(u(rng), u(rng), u(rng));
-  m.plane_normal = Vec3(u(rng), u(rng), u(rng)).normalized();
-  m.weight = 0.1 + 0.9 * std::abs(u(rng));
-  return m;
-}
 
 Vec3 RandomPoint(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -10,23 +10,15 @@
 
 #include "common/gradient_check.h"
 #include "ctlio/factors/lidar/point_to_plane_world.h"
+#include "lidar/random_association.h"
 
 namespace ctlio {
 namespace {
 
 using testing::JacobiansMatchNumeric;
 using testing::PoseParameters;
+using testing::RandomAssociation;
 using testing::RandomPose;
-
-PlaneAssociation RandomAssociation(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  PlaneAssociation m;
-  m.point_robot = 20.0 * Vec3(u(rng), u(rng), u(rng));
-  m.plane_point = 20.0 * Vec3(u(rng), u(rng), u(rng));
-  m.plane_normal = Vec3(u(rng), u(rng), u(rng)).normalized();
-  m.weight = 0.1 + 0.9 * std::abs(u(rng));
-  return m;
-}
 
 // The residual is w·nᵀ(p_ref − T_rm⁻¹ q), written out independently of the factor.
 TEST(PointToPlane, ResidualMatchesDefinition) {
