@@ -45,6 +45,17 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    residuals[0] = EvaluateAtKnots(*pose_, m_, parameters, jacobians, nullptr);
+    return true;
+  }
+
+  // The residual of `m` at the pose `pose` interpolates from the knots (blocks 0–5 of
+  // `parameters`) and the knots' Jacobians into blocks 0–5 of `jacobians` (nullable, each
+  // block nullable). With J_tau, de/dδT(τ) is also returned, for a factor with further blocks
+  // behind the pose (ContinuousPointToPlaneExtrinsic).
+  static double EvaluateAtKnots(const SharedPoseInterpolation& pose, const PlaneAssociation& m,
+                                double const* const* parameters, double** jacobians,
+                                Eigen::Matrix<double, 1, 6>* J_tau) {
     const bool want_k =
         jacobians != nullptr &&
         (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr);
@@ -52,25 +63,27 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
         jacobians != nullptr &&
         (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
     SharedPoseInterpolation::Scratch scratch;
-    const SharedPoseInterpolation::Result& x = pose_->Pose(parameters, want_k || want_k1, &scratch);
-    if (!want_k && !want_k1) {
-      residuals[0] = lidar::PointToPlaneError(x.at.T, m_, nullptr);
-      return true;
+    const SharedPoseInterpolation::Result& x = pose.Pose(parameters, want_k || want_k1, &scratch);
+    if (!want_k && !want_k1 && J_tau == nullptr) {
+      return lidar::PointToPlaneError(x.at.T, m, nullptr);
     }
-    Eigen::Matrix<double, 1, 6> J_tau;
-    residuals[0] = lidar::PointToPlaneError(x.at.T, m_, &J_tau);
-    Eigen::Matrix<double, 1, 18> J_k, J_k1;
-    pose_->Chain(x, J_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
-    if (want_k) WriteKnotJacobians(J_k, parameters[0], jacobians);
-    if (want_k1) WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
-    return true;
+    Eigen::Matrix<double, 1, 6> J;
+    const double e = lidar::PointToPlaneError(x.at.T, m, &J);
+    if (want_k || want_k1) {
+      Eigen::Matrix<double, 1, 18> J_k, J_k1;
+      pose.Chain(x, J, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
+      if (want_k) WriteKnotJacobians(J_k, parameters[0], jacobians);
+      if (want_k1) WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
+    }
+    if (J_tau != nullptr) *J_tau = J;
+    return e;
   }
 
   const PlaneAssociation& association() const { return m_; }
   const SharedPoseInterpolation& pose() const { return *pose_; }
 
-  // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks
-  // (also used by the variant with the extrinsic, continuous_point_to_plane_extrinsic.h).
+ private:
+  // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks.
   static void WriteKnotJacobians(const Eigen::Matrix<double, 1, 18>& J, const double* pose,
                                  double** out) {
     if (out[0] != nullptr) LiftPoseJacobian<1>(J.leftCols<6>(), pose, out[0]);
@@ -79,7 +92,6 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
     if (out[2] != nullptr) Row6{out[2]} = J.rightCols<6>();
   }
 
- private:
   std::shared_ptr<const SharedPoseInterpolation> pose_;
   PlaneAssociation m_;
 };

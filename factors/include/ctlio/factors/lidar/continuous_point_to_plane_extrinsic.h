@@ -46,29 +46,13 @@ class ContinuousPointToPlaneExtrinsic final
                 double** jacobians) const override {
     PlaneAssociation m = m_;
     m.point_robot = PoseManifold::Pose(parameters[6]) * point_lidar_;
-    const bool want_k =
-        jacobians != nullptr &&
-        (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr);
-    const bool want_k1 =
-        jacobians != nullptr &&
-        (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
     const bool want_rl = jacobians != nullptr && jacobians[6] != nullptr;
-    SharedPoseInterpolation::Scratch scratch;
-    const SharedPoseInterpolation::Result& x = pose_->Pose(parameters, want_k || want_k1, &scratch);
-    if (!want_k && !want_k1 && !want_rl) {
-      residuals[0] = lidar::PointToPlaneError(x.at.T, m, nullptr);
-      return true;
-    }
     Eigen::Matrix<double, 1, 6> J_tau;
-    residuals[0] = lidar::PointToPlaneError(x.at.T, m, &J_tau);
-    if (want_k || want_k1) {
-      Eigen::Matrix<double, 1, 18> J_k, J_k1;
-      pose_->Chain(x, J_tau, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
-      if (want_k) ContinuousPointToPlane::WriteKnotJacobians(J_k, parameters[0], jacobians);
-      if (want_k1) ContinuousPointToPlane::WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
-    }
-    if (want_rl)
+    residuals[0] = ContinuousPointToPlane::EvaluateAtKnots(*pose_, m, parameters, jacobians,
+                                                           want_rl ? &J_tau : nullptr);
+    if (want_rl) {
       LiftPoseJacobian<1>(Eigen::Matrix<double, 1, 6>(-J_tau), parameters[6], jacobians[6]);
+    }
     return true;
   }
 
