@@ -249,6 +249,7 @@ const std::vector<StateId>& SlidingWindow::StatesOf(ceres::ResidualBlockId id) c
 ceres::Solver::Summary SlidingWindow::Solve() {
   if (states_.empty()) Throw<std::logic_error>(__LINE__, "Solve() on an empty window");
   ceres::Solver::Summary summary;
+  shared_interpolations_->set_threads(options_.solver.num_threads);
   ceres::Solve(options_.solver, problem_.get(), &summary);
   return summary;
 }

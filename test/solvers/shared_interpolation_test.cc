@@ -42,7 +42,7 @@ struct Scene {
 };
 
 // Points seen from the true trajectory, each on a plane through its true map position.
-Scene MakeScene(uint32_t seed) {
+Scene MakeScene(uint32_t seed, int firings = kFirings) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const auto vec6 = [&](double s) {
@@ -62,8 +62,8 @@ Scene MakeScene(uint32_t seed) {
   s.guess0.pose = SE3::Exp(vec6(0.02)) * s.truth0.pose;
   s.guess1.pose = SE3::Exp(vec6(0.05)) * s.truth1.pose;
   s.guess1.velocity += vec6(0.2);
-  for (int f = 0; f < kFirings; ++f) {
-    s.tau.push_back(kT1 * (f + 0.5) / kFirings);
+  for (int f = 0; f < firings; ++f) {
+    s.tau.push_back(kT1 * (f + 0.5) / firings);
     const gp::GpInterpolator interp(Model(), 0.0, kT1, s.tau.back());
     SE3 T_rm;
     interp.Pose(s.truth0, s.truth1, &T_rm, nullptr, nullptr);
@@ -86,11 +86,12 @@ struct Built {
   std::vector<std::shared_ptr<gp::SharedStateInterpolation>> imu;  // empty without sharing
 };
 
-Built Build(const Scene& s, bool shared) {
+Built Build(const Scene& s, bool shared, int threads = 1) {
   Built b;
   SlidingWindowOptions options;
   options.solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.solver.max_num_iterations = 20;
+  options.solver.num_threads = threads;
   b.window = std::make_unique<SlidingWindow>(options);
   SlidingWindow& w = *b.window;
   const std::vector<StateId> ids = {0, 1, 2, 3, 4, 5};
@@ -106,7 +107,7 @@ Built Build(const Scene& s, bool shared) {
   w.AddResidualBlock(new gp::SingerPrior(Model(), kT1), nullptr, ids);
   const SharedPoseInterpolation::KnotBlocks blocks = {w.State(0), w.State(1), w.State(2),
                                                       w.State(3), w.State(4), w.State(5)};
-  for (int f = 0; f < kFirings; ++f) {
+  for (size_t f = 0; f < s.tau.size(); ++f) {
     auto interpolator = std::make_shared<const gp::GpInterpolator>(Model(), 0.0, kT1, s.tau[f]);
     std::shared_ptr<SharedPoseInterpolation> firing;
     if (shared) {
@@ -180,6 +181,24 @@ TEST(SharedInterpolationCallback, SolveReadsPreparedInterpolationAndMatchesUnsha
   EXPECT_LT(a.final_cost, a.initial_cost);
   for (StateId id = 0; id < 6; ++id) {
     EXPECT_LT((shared.window->Vector(id) - plain.window->Vector(id)).cwiseAbs().maxCoeff(), 1e-9)
+        << "state " << id;
+  }
+}
+
+// With the solver's threads the callback prepares the interpolations in parallel chunks once
+// there are enough of them (here 400 firings): every one is still prepared (none of the 4,000
+// residuals interpolates on its own) and the solution is that of one thread (up to the order of
+// Ceres' own parallel sums).
+TEST(SharedInterpolationCallback, ThreadsPrepareEveryInterpolation) {
+  const Scene scene = MakeScene(5, 400);
+  Built one = Build(scene, true, 1), two = Build(scene, true, 2);
+  const ceres::Solver::Summary a = one.window->Solve();
+  const ceres::Solver::Summary b = two.window->Solve();
+  EXPECT_GT(b.iterations.size(), 2u);
+  EXPECT_EQ(Computed(two), 0) << "a residual read an interpolation the callback skipped";
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-9 * a.final_cost);
+  for (StateId id = 0; id < 6; ++id) {
+    EXPECT_LT((one.window->Vector(id) - two.window->Vector(id)).cwiseAbs().maxCoeff(), 1e-9)
         << "state " << id;
   }
 }

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "ctlio/solvers/lio/parallel_for.h"
+#include "ctlio/solvers/parallel_for.h"
 
 namespace ctlio::lio {
 

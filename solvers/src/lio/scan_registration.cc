@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "ctlio/solvers/lio/frontend.h"
-#include "ctlio/solvers/lio/parallel_for.h"
+#include "ctlio/solvers/parallel_for.h"
 
 namespace ctlio::lio {
 

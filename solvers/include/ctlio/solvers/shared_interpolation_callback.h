@@ -21,6 +21,7 @@
 
 #include "ctlio/factors/gp/shared_interpolation.h"
 #include "ctlio/factors/gp/shared_knot_interval.h"
+#include "ctlio/solvers/parallel_for.h"
 
 namespace ctlio {
 
@@ -40,6 +41,11 @@ class SharedInterpolationCallback final : public ceres::EvaluationCallback {
     interpolation->set_interval(std::move(interval));
   }
 
+  // Threads for PrepareForEvaluation (the window sets its solver's num_threads here): the
+  // intervals are formed first, on the calling thread, then the interpolations, which only read
+  // them and write their own results, in contiguous chunks. Same results for any count.
+  void set_threads(int threads) { threads_ = std::max(threads, 1); }
+
   // The flags are not needed: Prepare always forms the Jacobians too, and skips an interpolation
   // whose knots have not moved since it was last prepared.
   void PrepareForEvaluation(bool /*evaluate_jacobians*/, bool /*new_evaluation_point*/) override {
@@ -49,10 +55,24 @@ class SharedInterpolationCallback final : public ceres::EvaluationCallback {
     for (auto it = intervals_.begin(); it != intervals_.end();) {
       it = it->second.expired() ? intervals_.erase(it) : std::next(it);
     }
+    active_.clear();
     for (const auto& weak : interpolations_) {
-      const std::shared_ptr<gp::SharedInterpolation> f = weak.lock();
-      if (f->active()) f->Prepare();
+      std::shared_ptr<gp::SharedInterpolation> f = weak.lock();
+      if (f->active()) active_.push_back(std::move(f));
     }
+    // A few thousand interpolations per evaluation are worth a second thread; a handful not.
+    const int threads = active_.size() >= 256 ? threads_ : 1;
+    if (threads > 1) {
+      for (const auto& [knots, weak] : intervals_) {
+        if (const std::shared_ptr<gp::SharedKnotInterval> interval = weak.lock()) {
+          interval->Prepare();
+        }
+      }
+    }
+    ParallelFor(threads, active_.size(), [&](size_t, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) active_[i]->Prepare();
+    });
+    active_.clear();
   }
 
   // Live interpolations (those some residual or their owner still holds).
@@ -65,6 +85,8 @@ class SharedInterpolationCallback final : public ceres::EvaluationCallback {
   std::vector<std::weak_ptr<gp::SharedInterpolation>> interpolations_;
   // One interval per knot-block tuple, held by the interpolations on it.
   std::map<gp::KnotBlocks, std::weak_ptr<gp::SharedKnotInterval>> intervals_;
+  std::vector<std::shared_ptr<gp::SharedInterpolation>> active_;  // this evaluation's, reused
+  int threads_ = 1;
 };
 
 }  // namespace ctlio

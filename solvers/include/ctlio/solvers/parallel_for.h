@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace ctlio::lio {
+namespace ctlio {
 
 template <typename F>
 void ParallelFor(int threads, size_t n, F&& f) {
@@ -45,4 +45,4 @@ void ParallelFor(int threads, size_t n, F&& f) {
   }
 }
 
-}  // namespace ctlio::lio
+}  // namespace ctlio
