@@ -262,6 +262,7 @@ TEST(Frontend, SelectSweepEqualsThePreprocessingStages) {
     if (i % 997 == 0) raw.back() = Vec3(0.3, -0.2, 0.0);   // inside min_range
     if (i % 1301 == 0) raw.back() = Vec3(40.0, 0.0, 0.0);  // exactly max_range
     if (i % 1999 == 0) raw.back() = Vec3(std::nan(""), 1.0, 1.0);
+    if (i % 2003 == 0) raw.back() = Vec3(-0.0, 2.0 + 1e-3 * i, -0.0);  // T·p turns −0 into +0
   }
   SE3 rotated_z(Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix(), Vec3::Zero());
   Mat3 flip;
@@ -313,6 +314,12 @@ TEST(Frontend, SelectSweepEqualsThePreprocessingStages) {
         ASSERT_GT(indices.size(), 5000u);
         EXPECT_EQ(selection.indices, indices) << "size " << size;
         EXPECT_EQ(selection.points_robot, points) << "size " << size;
+        for (size_t j = 0; j < std::min(points.size(), selection.points_robot.size()); ++j) {
+          for (int a = 0; a < 3; ++a) {
+            ASSERT_EQ(std::signbit(selection.points_robot[j][a]), std::signbit(points[j][a]))
+                << "sign of zero, point " << j;
+          }
+        }
         EXPECT_EQ(selection.keypoints, keypoints) << "size " << size;
       }
       EXPECT_EQ(frontend.num_scans(), 2);

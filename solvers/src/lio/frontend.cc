@@ -334,8 +334,10 @@ void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3&
   selection->points_robot.reserve(first.size());
   // C·p + r with C = I, r = 0 is p itself for a finite p (1·x + 0·y + 0·z + 0 = x; −0 becomes +0,
   // the same voxel), so the robot-frame gate and subsampling would keep every survivor.
-  const bool identity =
-      T_robot_lidar.rotation() == Mat3::Identity() && T_robot_lidar.translation() == Vec3::Zero();
+  // (r must be +0, not −0, for the bitwise equality below.)
+  const Vec3& r = T_robot_lidar.translation();
+  const bool identity = T_robot_lidar.rotation() == Mat3::Identity() && r == Vec3::Zero() &&
+                        !std::signbit(r.x()) && !std::signbit(r.y()) && !std::signbit(r.z());
   // Reused across calls: fresh tables per sweep cost allocations and page faults.
   thread_local PackedKeySet robot_seen, keypoint_seen;
   robot_seen.Clear();
@@ -345,20 +347,43 @@ void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3&
   const double min2 = options_.min_range * options_.min_range;
   const double max2 = options_.max_range * options_.max_range;
   std::vector<size_t> candidates;  // keypoints before the max_keypoints cap
-  for (const size_t i : first) {
-    const Vec3 q = T_robot_lidar * sweep_lidar[i];
-    if (!identity) {  // Preprocess: RangeGate, then VoxelGridSubsample
-      const double r2 = q.squaredNorm();
-      if (!(r2 >= min2 && r2 <= max2)) continue;
-      uint64_t key;
-      if (!PackedKey(q, inverse_size, &key) || !robot_seen.Insert(key)) continue;
-    }
+  // Every point reaching the keypoint voxels passed a range gate (|q| ≤ max_range), so their
+  // keys need no bounds check when the gate implies it.
+  const bool keypoint_key_in_range = GateBoundsKey(options_.max_range, inverse_keypoint_size);
+  const auto keep = [&](size_t i, const Vec3& q) {
     uint64_t keypoint_key;  // Keypoints: VoxelGridSubsample of the preprocessed points
-    if (PackedKey(q, inverse_keypoint_size, &keypoint_key) && keypoint_seen.Insert(keypoint_key)) {
+    bool valid = true;
+    if (keypoint_key_in_range) {
+      keypoint_key = PackedKeyInRange(q.x() * inverse_keypoint_size, q.y() * inverse_keypoint_size,
+                                      q.z() * inverse_keypoint_size);
+    } else {
+      valid = PackedKey(q, inverse_keypoint_size, &keypoint_key);
+    }
+    if (valid && keypoint_seen.Insert(keypoint_key)) {
       candidates.push_back(selection->indices.size());
     }
     selection->indices.push_back(i);
     selection->points_robot.push_back(q);
+  };
+  if (identity) {
+    // T·p is p + 0 here, bit for bit: each row sums x·1 and signed zeros, then adds r = +0, which
+    // leaves x ≠ 0 unchanged and turns a zero of either sign into +0 — as p + 0 does.
+    for (const size_t i : first) keep(i, sweep_lidar[i] + Vec3::Zero());
+  } else {
+    const bool key_in_range = GateBoundsKey(options_.max_range, inverse_size);
+    for (const size_t i : first) {
+      const Vec3 q = T_robot_lidar * sweep_lidar[i];
+      // Preprocess: RangeGate, then VoxelGridSubsample.
+      const double r2 = q.squaredNorm();
+      if (!(r2 >= min2 && r2 <= max2)) continue;
+      uint64_t key;
+      if (key_in_range) {
+        key = PackedKeyInRange(q.x() * inverse_size, q.y() * inverse_size, q.z() * inverse_size);
+      } else if (!PackedKey(q, inverse_size, &key)) {
+        continue;
+      }
+      if (robot_seen.Insert(key)) keep(i, q);
+    }
   }
   // Keypoints' evenly spaced subset.
   const size_t cap = static_cast<size_t>(options_.max_keypoints);
