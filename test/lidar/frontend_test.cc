@@ -219,6 +219,114 @@ TEST(Frontend, RangeGatedVoxelIndicesMatchesReferenceForAnyThreads) {
   }
 }
 
+// The first point of each voxel among `points`, in order (std::floor keys, an ordered set).
+std::vector<size_t> FirstOfVoxelReference(const std::vector<Vec3>& points, double size) {
+  std::vector<size_t> kept;
+  std::set<std::tuple<int64_t, int64_t, int64_t>> seen;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    if (!p.allFinite()) continue;
+    const double inverse = 1.0 / size;  // the voxel of p is ⌊p · (1 / size)⌋
+    if (seen.insert({static_cast<int64_t>(std::floor(p.x() * inverse)),
+                     static_cast<int64_t>(std::floor(p.y() * inverse)),
+                     static_cast<int64_t>(std::floor(p.z() * inverse))})
+            .second) {
+      kept.push_back(i);
+    }
+  }
+  return kept;
+}
+
+// SelectSweep (one stream, identity shortcut) against the stages done one after the other with
+// reference sets: the lidar-frame gate + 0.5 m subsampling, the robot-frame gate + subsampling
+// of T·survivors, the 1 m keypoint voxels and the evenly spaced cap. Raw points on and one ulp
+// beside voxel boundaries, negative ones, NaN, repeats, at the range limits; the identity, a
+// rotation about z by π (a grid symmetry up to the floor's half-open cells) and the Newer
+// College-like extrinsic; initial and regular voxel size; with and without a keypoint cap.
+TEST(Frontend, SelectSweepEqualsThePreprocessingStages) {
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> u(-30.0, 30.0);
+  std::uniform_int_distribution<int> cell(-60, 60);
+  std::vector<Vec3> raw;
+  for (int i = 0; i < 20000; ++i) {
+    if (i % 5 == 0) {
+      Vec3 p(0.5 * cell(rng), 0.5 * cell(rng), 0.25 * cell(rng));
+      if (i % 3 == 1) p.x() = std::nextafter(p.x(), -1e9);
+      if (i % 3 == 2) p.z() = std::nextafter(p.z(), 1e9);
+      raw.push_back(p);
+    } else if (i % 5 == 1 && !raw.empty()) {
+      raw.push_back(raw[raw.size() - 1 - rng() % std::min<size_t>(raw.size(), 200)]);
+    } else {
+      raw.emplace_back(u(rng), u(rng), 0.2 * u(rng));
+    }
+    if (i % 997 == 0) raw.back() = Vec3(0.3, -0.2, 0.0);   // inside min_range
+    if (i % 1301 == 0) raw.back() = Vec3(40.0, 0.0, 0.0);  // exactly max_range
+    if (i % 1999 == 0) raw.back() = Vec3(std::nan(""), 1.0, 1.0);
+    if (i % 2003 == 0) raw.back() = Vec3(-0.0, 2.0 + 1e-3 * i, -0.0);  // T·p turns −0 into +0
+  }
+  SE3 rotated_z(Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix(), Vec3::Zero());
+  Mat3 flip;
+  flip << -1, 0, 0, 0, -1, 0, 0, 0, 1;
+  const SE3 newer_college(flip, Vec3(-0.006253, 0.011775, 0.028535));
+  for (const SE3& T : {SE3(), rotated_z, newer_college}) {
+    for (const int cap : {0, 600}) {
+      LidarFrontendOptions options;
+      options.min_range = 1.0;
+      options.max_range = 40.0;
+      options.initial_scans = 1;
+      options.max_keypoints = cap;
+      LidarFrontend frontend(options);
+      for (const double size : {options.initial_voxel_size, options.voxel_size}) {
+        SweepSelection selection;
+        frontend.SelectSweep(raw, T, &selection);
+        // Reference: each stage on the previous one's survivors.
+        std::vector<Vec3> gated;
+        std::vector<size_t> gated_index;
+        for (size_t i = 0; i < raw.size(); ++i) {
+          const double r2 = raw[i].squaredNorm();
+          if (r2 >= 1.0 && r2 <= 1600.0) {
+            gated.push_back(raw[i]);
+            gated_index.push_back(i);
+          }
+        }
+        std::vector<Vec3> robot;
+        std::vector<size_t> robot_index;
+        for (const size_t j : FirstOfVoxelReference(gated, size)) {
+          const Vec3 q = T * gated[j];
+          const double r2 = q.squaredNorm();
+          if (r2 >= 1.0 && r2 <= 1600.0) {
+            robot.push_back(q);
+            robot_index.push_back(gated_index[j]);
+          }
+        }
+        std::vector<size_t> indices;
+        std::vector<Vec3> points;
+        for (const size_t j : FirstOfVoxelReference(robot, size)) {
+          indices.push_back(robot_index[j]);
+          points.push_back(robot[j]);
+        }
+        std::vector<size_t> keypoints = FirstOfVoxelReference(points, 1.0);
+        if (cap > 0 && keypoints.size() > static_cast<size_t>(cap)) {
+          std::vector<size_t> spaced;
+          for (int i = 0; i < cap; ++i) spaced.push_back(keypoints[i * keypoints.size() / cap]);
+          keypoints = spaced;
+        }
+        ASSERT_GT(indices.size(), 5000u);
+        EXPECT_EQ(selection.indices, indices) << "size " << size;
+        EXPECT_EQ(selection.points_robot, points) << "size " << size;
+        for (size_t j = 0; j < std::min(points.size(), selection.points_robot.size()); ++j) {
+          for (int a = 0; a < 3; ++a) {
+            ASSERT_EQ(std::signbit(selection.points_robot[j][a]), std::signbit(points[j][a]))
+                << "sign of zero, point " << j;
+          }
+        }
+        EXPECT_EQ(selection.keypoints, keypoints) << "size " << size;
+      }
+      EXPECT_EQ(frontend.num_scans(), 2);
+    }
+  }
+}
+
 TEST(Frontend, PreprocessUsesFineVoxelsForInitialScans) {
   std::mt19937 rng(24);
   LidarFrontendOptions options;

@@ -6,7 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <random>
+#include <tuple>
 
 #include "ctlio/solvers/lio/frontend.h"
 
@@ -53,6 +56,80 @@ TEST(VoxelMap, BoundsAndSpacingHold) {
   EXPECT_EQ(total, map.num_points());
   EXPECT_EQ(map.num_voxels(), 216u);
   EXPECT_GT(full_voxels, 200);
+}
+
+// Batch insertion (the lookup cache, the two-points-per-step distance test) against point-by-point
+// insertion into a reference built on std::floor keys and an ordered map, with points exactly at
+// and one ulp inside / outside the minimum spacing, on voxel faces, at negative coordinates,
+// NaN, repeated points, and voxels revisited a few hundred points later (cache hits) and
+// colliding in the cache.
+TEST(VoxelMap, BatchInsertEqualsPointByPointReference) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  std::uniform_int_distribution<int> cell(-4, 3);
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 40000; ++i) {
+    switch (i % 7) {
+      case 0: {  // on a voxel face (or one ulp below it)
+        Vec3 p(cell(rng), u(rng), cell(rng));
+        if (i % 2 == 0) p.x() = std::nextafter(p.x(), -1e9);
+        pts.push_back(p);
+        break;
+      }
+      case 1: {  // exactly min_point_distance (0.1) from an earlier point along x, ± one ulp
+        const Vec3 q = pts[rng() % pts.size()];
+        Vec3 p = q + Vec3(0.1, 0.0, 0.0);
+        if (i % 3 == 1) p.x() = std::nextafter(p.x(), 1e9);
+        if (i % 3 == 2) p.x() = std::nextafter(p.x(), -1e9);
+        pts.push_back(p);
+        break;
+      }
+      case 2:  // a repeat of a recent point (the same voxel a "firing" later)
+        pts.push_back(pts[pts.size() - 1 - rng() % std::min<size_t>(pts.size(), 300)]);
+        break;
+      default:
+        pts.emplace_back(u(rng), u(rng), 0.3 * u(rng));
+    }
+    if (i % 1777 == 0) pts.back() = Vec3(std::nan(""), 0.0, 1.0);
+    if (i % 1999 == 0) pts.back() = Vec3(1.0, std::numeric_limits<double>::infinity(), 1.0);
+  }
+  for (const int max_points : {3, 20}) {
+    VoxelMap::Options o;
+    o.max_points_per_voxel = max_points;
+    VoxelMap map(o);
+    // Two batches, so the second starts with a populated map.
+    const size_t half = pts.size() / 2;
+    size_t kept = map.Insert(std::vector<Vec3>(pts.begin(), pts.begin() + half));
+    kept += map.Insert(std::vector<Vec3>(pts.begin() + half, pts.end()));
+    std::map<std::tuple<int, int, int>, std::vector<Vec3>> reference;
+    size_t reference_kept = 0;
+    for (const Vec3& p : pts) {
+      if (!p.allFinite()) continue;
+      auto& voxel =
+          reference[{static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())),
+                     static_cast<int>(std::floor(p.z()))}];
+      if (static_cast<int>(voxel.size()) >= max_points) continue;
+      bool close = false;
+      for (const Vec3& q : voxel) close = close || (q - p).squaredNorm() < 0.1 * 0.1;
+      if (close) continue;
+      voxel.push_back(p);
+      ++reference_kept;
+    }
+    EXPECT_EQ(kept, reference_kept);
+    EXPECT_EQ(map.num_voxels(), reference.size());
+    size_t compared = 0;
+    map.ForEachVoxel([&](const VoxelKey& k, const VoxelPoints& v) {
+      const auto it = reference.find({k.x, k.y, k.z});
+      ASSERT_NE(it, reference.end());
+      ASSERT_EQ(v.size(), it->second.size());
+      for (size_t i = 0; i < v.size(); ++i) {
+        EXPECT_EQ(v[i], it->second[i]) << "voxel " << k.x << " " << k.y << " " << k.z;
+      }
+      ++compared;
+    });
+    EXPECT_EQ(compared, reference.size());
+    EXPECT_GT(reference_kept, 1000u);
+  }
 }
 
 TEST(VoxelMap, RejectsClosePointsAndFullVoxels) {

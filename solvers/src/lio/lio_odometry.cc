@@ -320,30 +320,27 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   prepared.t_begin = imu_.Seconds(scan.begin_ns);
   prepared.t_end = imu_.Seconds(scan.end_ns);
   prepared.end_ns = scan.end_ns;
-  // Range gate and voxel subsampling in the lidar frame first (one pass, no copy of the up to
-  // 230 000 raw returns of a 128-beam sweep); Preprocess then repeats both on the few thousand
-  // survivors in the robot frame (idempotent up to the extrinsic's shift of the voxel grid).
-  const std::vector<size_t> kept =
-      RangeGatedVoxelIndices(scan.points, frontend_.NextVoxelSize(), config_.frontend.min_range,
-                             config_.frontend.max_range, config_.frontend.threads);
   // The configured extrinsic, or with online calibration its current estimate (the lidar
   // residuals recover the lidar-frame points through prepared.T_robot_lidar).
   prepared.T_robot_lidar =
       window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
-  const SE3& T_robot_lidar = prepared.T_robot_lidar;
-  std::vector<TimedPoint> raw;
-  raw.reserve(kept.size());
-  for (const size_t i : kept) {
-    TimedPoint p;
-    p.point = T_robot_lidar * scan.points[i];
+  // Range gate and voxel subsampling in the lidar frame (one pass, no copy of the up to 230 000
+  // raw returns of a 128-beam sweep), then on the survivors in the robot frame, and the
+  // keypoints: one stream, no intermediate copies (LidarFrontend::SelectSweep).
+  thread_local SweepSelection selection;
+  frontend_.SelectSweep(scan.points, prepared.T_robot_lidar, &selection);
+  prepared.points.resize(selection.indices.size());
+  for (size_t j = 0; j < selection.indices.size(); ++j) {
+    TimedPoint& p = prepared.points[j];
+    p.point = selection.points_robot[j];
     // Points are registered between the previous knot and this one; a time outside by less than
     // input.scan_time_tolerance (clock jitter of the driver; the rest was dropped and counted in
-    // DropPointsOutsideInterval) is clamped onto the interval rather than extrapolated.
-    p.time = std::clamp(imu_.Seconds(scan.times_ns[i]), t_prev, prepared.t_end);
-    raw.push_back(p);
+    // DropPointsOutsideInterval) is clamped onto the interval rather than extrapolated. Finite,
+    // so Preprocess's time check (RangeGate) would keep every point.
+    p.time = std::clamp(imu_.Seconds(scan.times_ns[selection.indices[j]]), t_prev, prepared.t_end);
   }
-  prepared.points = frontend_.Preprocess(raw);
-  prepared.keypoints = frontend_.Keypoints(prepared.points);
+  prepared.keypoints.reserve(selection.keypoints.size());
+  for (const size_t j : selection.keypoints) prepared.keypoints.push_back(prepared.points[j]);
   SortByTime(&prepared.points);
   SortByTime(&prepared.keypoints);
   return prepared;

@@ -5,6 +5,10 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace ctlio::lio {
 
 namespace {
@@ -86,13 +90,39 @@ bool VoxelMap::Insert(const Vec3& p) {
   return kept;
 }
 
-bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
+// Inline (only this file calls them, once per map point): the call overheads were a third of
+// the insertion's instructions.
+inline bool VoxelMap::HasPointCloserThanMin(const Vec3* points, int32_t n, const Vec3& p) const {
+  int32_t i = 0;
+#if defined(__SSE2__)
+  // Two points per step (x86-64 always has SSE2; the points are packed x0 y0 z0 x1 y1 z1): the
+  // same products and sums in the same order ((dx² + dy²) + dz², no FMA) as the scalar loop
+  // below, so the same comparisons, in about half the instructions.
+  const __m128d px = _mm_set1_pd(p.x()), py = _mm_set1_pd(p.y()), pz = _mm_set1_pd(p.z());
+  const __m128d min2 = _mm_set1_pd(min_distance2_);
+  for (; i + 2 <= n; i += 2) {
+    const double* q = points[i].data();
+    const __m128d a = _mm_loadu_pd(q), b = _mm_loadu_pd(q + 2), c = _mm_loadu_pd(q + 4);
+    const __m128d dx = _mm_sub_pd(_mm_shuffle_pd(a, b, 2), px);  // x0, x1
+    const __m128d dy = _mm_sub_pd(_mm_shuffle_pd(a, c, 1), py);  // y0, y1
+    const __m128d dz = _mm_sub_pd(_mm_shuffle_pd(b, c, 2), pz);  // z0, z1
+    const __m128d d2 =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz));
+    if (_mm_movemask_pd(_mm_cmplt_pd(d2, min2)) != 0) return true;
+  }
+#endif
+  for (; i < n; ++i) {
+    const double dx = points[i].x() - p.x(), dy = points[i].y() - p.y(), dz = points[i].z() - p.z();
+    if ((dx * dx + dy * dy) + dz * dz < min_distance2_) return true;
+  }
+  return false;
+}
+
+inline bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
   int32_t& count = counts_[voxel];
   if (count >= options_.max_points_per_voxel) return false;
   Vec3* points = BlockOf(voxel);
-  for (int32_t i = 0; i < count; ++i) {
-    if ((points[i] - p).squaredNorm() < min_distance2_) return false;
-  }
+  if (HasPointCloserThanMin(points, count, p)) return false;
   points[count++] = p;
   ++num_points_;
   if (options_.fit_planes) {
@@ -150,11 +180,14 @@ size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
   size_t kept = 0;
   int32_t last_voxel = kNoVoxel;
   VoxelKey last_key;
+  recent_.assign(size_t{1} << kRecentBits, RecentVoxel{});
   for (const Vec3& p : points) {
     if (!p.allFinite()) continue;
     const VoxelKey key = VoxelKeyOf(p, inverse_voxel_size_);
     if (last_voxel == kNoVoxel || !(key == last_key)) {
-      last_voxel = FindOrAdd(key);
+      RecentVoxel& recent = recent_[RecentSlot(key)];
+      if (recent.voxel == kNoVoxel || !(recent.key == key)) recent = {key, FindOrAdd(key)};
+      last_voxel = recent.voxel;
       last_key = key;
     }
     kept += InsertInto(last_voxel, p) ? 1 : 0;

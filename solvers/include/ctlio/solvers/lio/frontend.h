@@ -62,6 +62,13 @@ class PlaneAssociator {
   std::vector<VoxelMap::Neighbour> neighbours_;
 };
 
+// A preprocessed sweep as positions in the raw (lidar-frame) sweep, in sweep order.
+struct SweepSelection {
+  std::vector<size_t> indices;     // raw indices of the preprocessed points
+  std::vector<Vec3> points_robot;  // T_robot_lidar · raw point, per entry of indices
+  std::vector<size_t> keypoints;   // entries of indices that are keypoints, increasing
+};
+
 // Per-sweep preprocessing with the scan counter of the SPEC (finer subsampling for the first
 // scans), and the voxel-map options of the front-end options.
 class LidarFrontend {
@@ -71,6 +78,16 @@ class LidarFrontend {
   // Range gate + subsampling (voxel_size, or initial_voxel_size for the first initial_scans
   // sweeps). Advances the scan counter.
   std::vector<TimedPoint> Preprocess(const std::vector<TimedPoint>& sweep);
+  // Preprocess and Keypoints of a raw lidar-frame sweep without copying it: the range gate and
+  // subsampling in the lidar frame (RangeGatedVoxelIndices, options' threads), then, streamed over
+  // its survivors in order, the same in the robot frame (T_robot_lidar · p) and the keypoint
+  // voxels. The same points and keypoints as Keypoints(Preprocess(T_robot_lidar · survivors)):
+  // each stage keeps the first point of a voxel among the previous stage's survivors in their
+  // order, which a stream of filters computes alike. With an identity extrinsic the robot-frame
+  // stage is skipped: it would keep every survivor (same points, gate and voxels, one point per
+  // voxel already). Advances the scan counter.
+  void SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3& T_robot_lidar,
+                   SweepSelection* selection);
   // The voxel size the next Preprocess call will use.
   double NextVoxelSize() const;
   // One keypoint per keypoint_voxel_size voxel of a preprocessed sweep.

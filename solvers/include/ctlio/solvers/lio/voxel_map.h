@@ -149,6 +149,25 @@ class VoxelMap {
   bool InsertInto(int32_t voxel, const Vec3& p);
   // Refits the planes of the voxels whose points changed since the last call.
   void RefitChangedPlanes();
+  // Whether p lies closer than min_point_distance to one of the n points at `points`.
+  bool HasPointCloserThanMin(const Vec3* points, int32_t n, const Vec3& p) const;
+
+  // Insert's direct-mapped cache of voxel lookups (a few thousand entries, L1/L2-resident):
+  // the same beam of the next firings mostly falls in the voxel it fell in before, a firing's
+  // worth of points back, where the previous-point shortcut does not reach. Filled and read
+  // within one Insert call only (voxel indices stay valid until RemoveFar or Clear).
+  static constexpr int kRecentBits = 10;
+  struct RecentVoxel {
+    VoxelKey key;
+    int32_t voxel = kNoVoxel;
+  };
+  static size_t RecentSlot(const VoxelKey& k) {
+    const uint32_t h = static_cast<uint32_t>(k.x) * 0x9e3779b1u ^
+                       static_cast<uint32_t>(k.y) * 0x85ebca77u ^
+                       static_cast<uint32_t>(k.z) * 0xc2b2ae3du;
+    return h >> (32 - kRecentBits);
+  }
+  std::vector<RecentVoxel> recent_;
 
   // Σd and the upper triangle of Σd·dᵀ (xx, xy, xz, yy, yz, zz) of a voxel's points, d = p − the
   // voxel's corner.
