@@ -367,6 +367,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.loss_scale, d.loss_scale);
   EXPECT_EQ(o.convergence_translation, d.convergence_translation);
   EXPECT_EQ(o.convergence_rotation, d.convergence_rotation);
+  EXPECT_EQ(o.reassociation_distance, 0.0);
+  EXPECT_EQ(o.reassociation_distance, d.reassociation_distance);
   EXPECT_EQ(o.association, "knn");
   EXPECT_EQ(o.association, d.association);
   EXPECT_EQ(o.voxel_plane_max_thickness, d.voxel_plane_max_thickness);
@@ -393,6 +395,8 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_NE(ErrorOf("loss: tukey\n").find("loss"), std::string::npos);
   EXPECT_NE(ErrorOf("association: kdtree\n").find("association"), std::string::npos);
   EXPECT_NE(ErrorOf("threads: 0\n").find("threads"), std::string::npos);
+  EXPECT_NE(ErrorOf("reassociation_distance: -0.1\n").find("reassociation_distance"),
+            std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);
   EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("voxel_size: 0.3\n")).voxel_size, 0.3);
   EXPECT_THROW(LoadLidarFrontendOptions("/nonexistent/lidar.yaml"), std::runtime_error);

@@ -39,9 +39,14 @@ class RigidLidarTerm final : public LidarTerm {
     *q = keypoints_[i].point;
     *p_map = T_mr_ * *q;
   }
-  ceres::ResidualBlockId AddResidual(size_t, const PlaneAssociation& a, ceres::LossFunction* loss,
+  ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& a, ceres::LossFunction* loss,
                                      SlidingWindow* window) override {
-    return window->AddResidualBlock(new PointToPlane(a), loss, {pose_});
+    if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
+    costs_[i] = new PointToPlane(a);
+    return window->AddResidualBlock(costs_[i], loss, {pose_});
+  }
+  void UpdateResidual(size_t i, const PlaneAssociation& a) override {
+    costs_[i]->set_association(a);
   }
   SE3 NewestPose() const override { return PoseManifold::Pose(block_); }
 
@@ -50,6 +55,7 @@ class RigidLidarTerm final : public LidarTerm {
   const double* block_;
   const std::vector<TimedPoint>& keypoints_;
   SE3 T_mr_;
+  std::vector<PointToPlane*> costs_;  // per keypoint, owned by the window
 };
 
 inline RegistrationSummary RegisterRigid(const VoxelMap& map, const LidarFrontendOptions& options,

@@ -307,17 +307,18 @@ GpInterpolator::GpInterpolator(const SingerModel<6>& model, double t_k, double t
       const SingerShape sT = EvaluateSingerShape(alpha[i] * dT);
       const Eigen::Matrix3d W = SingerSqrtInformationFromShape(sT, 1.0, dT);
       const Eigen::Matrix3d PhiT = SingerModel<6>::ShapeTransition(sT, dT);
+      // Evaluated once for Q(τ−t_k) and Φ(τ−t_k) (the shapes are most of this constructor's
+      // cost, paid per firing of a scan).
+      const SingerShape s1 = EvaluateSingerShape(alpha[i] * d1);
       if (d1 == 0.0) {
         O.setZero();
       } else {
-        const SingerShape s1 = EvaluateSingerShape(alpha[i] * d1);
         const SingerShape s2 = EvaluateSingerShape(alpha[i] * d2);
         const Eigen::Matrix3d Q1 = SingerModel<6>::Scaled(s1, d1);
         const Eigen::Matrix3d Phi2 = SingerModel<6>::ShapeTransition(s2, d2);
         O = Q1 * Phi2.transpose() * W.transpose() * W;
       }
-      const Eigen::Matrix3d Phi1 =
-          SingerModel<6>::ShapeTransition(EvaluateSingerShape(alpha[i] * d1), d1);
+      const Eigen::Matrix3d Phi1 = SingerModel<6>::ShapeTransition(s1, d1);
       L = Phi1 - O * PhiT;
       if (rates) {
         // Ω' = AΩ + e₃e₃ᵀΦ(t_{k+1}−τ)ᵀQ(T)⁻¹, Λ' = AΦ(τ−t_k) − Ω'Φ(T) (header; Qc = 1).

@@ -57,13 +57,25 @@ ceres::ResidualBlockId ContinuousLidarTerm::AddResidual(size_t i,
                                                         SlidingWindow* window) {
   const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
   firing->set_active(true);
+  if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
   if (extrinsic_ != nullptr) {
     std::vector<StateId> states = states_;
     states.push_back(kExtrinsicKey);
-    return window->AddResidualBlock(
-        new ContinuousPointToPlaneExtrinsic(firing, association, points_lidar_[i]), loss, states);
+    costs_[i] = new ContinuousPointToPlaneExtrinsic(firing, association, points_lidar_[i]);
+    return window->AddResidualBlock(costs_[i], loss, states);
   }
-  return window->AddResidualBlock(new ContinuousPointToPlane(firing, association), loss, states_);
+  costs_[i] = new ContinuousPointToPlane(firing, association);
+  return window->AddResidualBlock(costs_[i], loss, states_);
+}
+
+void ContinuousLidarTerm::UpdateResidual(size_t i, const PlaneAssociation& association) {
+  // The residual reads its firing's interpolation in this round's solve.
+  firings_[firing_[i]]->set_active(true);
+  if (extrinsic_ != nullptr) {
+    static_cast<ContinuousPointToPlaneExtrinsic*>(costs_[i])->set_association(association);
+  } else {
+    static_cast<ContinuousPointToPlane*>(costs_[i])->set_association(association);
+  }
 }
 
 ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1,

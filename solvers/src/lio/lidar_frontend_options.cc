@@ -43,6 +43,7 @@ void LidarFrontendOptions::Validate() const {
   require(loss_scale > 0.0, "loss_scale must be positive");
   require(convergence_translation >= 0.0 && convergence_rotation >= 0.0,
           "convergence thresholds must be >= 0");
+  require(reassociation_distance >= 0.0, "reassociation_distance must be >= 0 (0 = always search)");
 }
 
 LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const std::string& source,
@@ -78,6 +79,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"loss_scale", SetFromYaml(&o.loss_scale)},
       {"convergence_translation", SetFromYaml(&o.convergence_translation)},
       {"convergence_rotation", SetFromYaml(&o.convergence_rotation)},
+      {"reassociation_distance", SetFromYaml(&o.reassociation_distance)},
   };
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();

@@ -48,9 +48,14 @@ class DeskewedLidarTerm final : public LidarTerm {
     *q = table_.ToEnd(keypoints_[i].time, keypoints_[i].point);
     *p_map = T_wb_ * *q;
   }
-  ceres::ResidualBlockId AddResidual(size_t, const PlaneAssociation& association,
+  ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
                                      ceres::LossFunction* loss, SlidingWindow* window) override {
-    return window->AddResidualBlock(new PointToPlaneWorld(association), loss, {s_.keys.pose});
+    if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
+    costs_[i] = new PointToPlaneWorld(association);
+    return window->AddResidualBlock(costs_[i], loss, {s_.keys.pose});
+  }
+  void UpdateResidual(size_t i, const PlaneAssociation& association) override {
+    costs_[i]->set_association(association);
   }
   SE3 NewestPose() const override { return PoseManifold::Pose(s_.pose); }
 
@@ -60,6 +65,8 @@ class DeskewedLidarTerm final : public LidarTerm {
   const std::vector<TimedPoint>& keypoints_;
   NavStateEstimator::DeskewTable table_;
   SE3 T_wb_;
+  // Per keypoint: its residual's cost function (owned by the window), for UpdateResidual.
+  std::vector<PointToPlaneWorld*> costs_;
 };
 
 }  // namespace

@@ -38,37 +38,68 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
                                            PlaneAssociator(map, options_));
   const size_t n = term->num_keypoints();
   std::vector<Vec3> q(n), p_map(n);
-  std::vector<PlaneAssociation> associations(n);
-  std::vector<uint8_t> associated(n);
-  std::vector<ceres::ResidualBlockId> blocks;
+  // Per keypoint: the plane of its last search (weight not whitened), whether that search found
+  // one, and where the keypoint was in the map then.
+  std::vector<PlaneAssociation> planes(n);
+  std::vector<uint8_t> associated(n, 0);
+  std::vector<Vec3> searched_at(n);
+  // Per keypoint: its residual in the window (nullptr: none).
+  std::vector<ceres::ResidualBlockId> block(n, nullptr);
+  auto remove_all = [&] {
+    for (ceres::ResidualBlockId& id : block) {
+      if (id != nullptr) window->RemoveResidualBlock(id);
+      id = nullptr;
+    }
+  };
+  const double reuse_squared = options_.reassociation_distance * options_.reassociation_distance;
   SE3 last_pose = term->NewestPose();
   for (int round = 0; round < options_.max_iterations; ++round) {
-    // Associate: this round's residuals replace the previous round's.
+    // Associate at the current estimate.
     auto t0 = Clock::now();
-    for (ceres::ResidualBlockId id : blocks) window->RemoveResidualBlock(id);
-    blocks.clear();
     term->BeginRound();
-    // One loss per round, shared by its residuals; once a residual uses it the window owns it
-    // (ref-counted by Ceres, deleted with the last such residual).
-    std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
     for (size_t i = 0; i < n; ++i) term->Locate(i, &q[i], &p_map[i]);
     ParallelFor(threads, n, [&](size_t chunk, size_t begin, size_t end) {
       PlaneAssociator& associator = associators[chunk];
       for (size_t i = begin; i < end; ++i) {
-        associated[i] = associator.Associate(q[i], p_map[i], &associations[i]) ? 1 : 0;
+        // A keypoint that moved less than reassociation_distance in the map since its plane
+        // was searched keeps that plane (0: search every round); the distance gate stays that
+        // of the search.
+        if (associated[i] && (p_map[i] - searched_at[i]).squaredNorm() < reuse_squared) {
+          planes[i].point_robot = q[i];
+          continue;
+        }
+        searched_at[i] = p_map[i];
+        associated[i] = associator.Associate(q[i], p_map[i], &planes[i]) ? 1 : 0;
       }
     });
+    // This round's residuals replace the previous round's: a keypoint associated again keeps
+    // its residual block with the new plane written into it (the same residual as a new block
+    // on that plane), one that lost its plane loses its block, a new one gets a block.
+    // One loss for the new blocks of the round, shared by them; once a residual uses it the
+    // window owns it (ref-counted by Ceres, deleted with the last such residual).
+    std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
+    bool loss_used = false;
+    int associations = 0;
     for (size_t i = 0; i < n; ++i) {
-      if (!associated[i]) continue;
-      PlaneAssociation& a = associations[i];
+      if (!associated[i]) {
+        if (block[i] != nullptr) window->RemoveResidualBlock(block[i]);
+        block[i] = nullptr;
+        continue;
+      }
+      PlaneAssociation a = planes[i];
       a.weight /= options_.point_noise_sigma;
-      blocks.push_back(term->AddResidual(i, a, loss.get(), window));
+      if (block[i] != nullptr) {
+        term->UpdateResidual(i, a);
+      } else {
+        block[i] = term->AddResidual(i, a, loss.get(), window);
+        loss_used = true;
+      }
+      ++associations;
     }
-    if (!blocks.empty()) loss.release();
-    summary.associations = static_cast<int>(blocks.size());
+    if (loss_used) loss.release();
+    summary.associations = associations;
     if (summary.associations < min_associations_) {
-      for (ceres::ResidualBlockId id : blocks) window->RemoveResidualBlock(id);
-      blocks.clear();
+      remove_all();
       summary.degenerate = true;
     }
     summary.ms_associate += MsSince(t0);
@@ -93,7 +124,9 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
       break;
     }
   }
-  summary.lidar_blocks = blocks;
+  for (ceres::ResidualBlockId id : block) {
+    if (id != nullptr) summary.lidar_blocks.push_back(id);
+  }
   return summary;
 }
 

@@ -81,6 +81,10 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
 
   const PlaneAssociation& association() const { return m_; }
   const SharedPoseInterpolation& pose() const { return *pose_; }
+  // A new association of the same point (the next association round of a scan registration),
+  // so the residual block stays in the problem instead of being removed and added again.
+  // Between solves only: Ceres must not be evaluating this cost function.
+  void set_association(const PlaneAssociation& association) { m_ = association; }
 
  private:
   // J (1×18) = [pose (tangent), ϖ, ϖ̇] of one knot into its three (nullable) ambient blocks.

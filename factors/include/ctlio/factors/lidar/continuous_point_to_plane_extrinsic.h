@@ -58,6 +58,11 @@ class ContinuousPointToPlaneExtrinsic final
 
   const PlaneAssociation& association() const { return m_; }
   const Vec3& point_lidar() const { return point_lidar_; }
+  // A new association of the same point (the next association round of a scan registration),
+  // so the residual block stays in the problem instead of being removed and added again.
+  // The point in the lidar frame is unchanged (its point_robot is not
+  // read). Between solves only: Ceres must not be evaluating this cost function.
+  void set_association(const PlaneAssociation& association) { m_ = association; }
   const SharedPoseInterpolation& pose() const { return *pose_; }
 
  private:

@@ -65,6 +65,10 @@ class PointToPlane final : public ceres::SizedCostFunction<1, 7> {
   }
 
   const PlaneAssociation& association() const { return m_; }
+  // A new association of the same point (the next association round of a scan registration),
+  // so the residual block stays in the problem instead of being removed and added again.
+  // Between solves only: Ceres must not be evaluating this cost function.
+  void set_association(const PlaneAssociation& association) { m_ = association; }
 
  private:
   PlaneAssociation m_;

@@ -40,6 +40,7 @@ class ContinuousLidarTerm final : public LidarTerm {
   void Locate(size_t i, Vec3* q, Vec3* p_map) override;
   ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
                                      ceres::LossFunction* loss, SlidingWindow* window) override;
+  void UpdateResidual(size_t i, const PlaneAssociation& association) override;
   SE3 NewestPose() const override;  // T_rm of knot k1
 
   int num_firings() const { return static_cast<int>(firings_.size()); }
@@ -53,6 +54,10 @@ class ContinuousLidarTerm final : public LidarTerm {
   // Per firing, this round: the map pose at the current estimate (for the association).
   std::vector<SE3> T_mr_;
   std::vector<bool> located_;
+  // Per keypoint: the cost function AddResidual gave it (ContinuousPointToPlane, or
+  // ContinuousPointToPlaneExtrinsic with calibration), owned by the window; read by
+  // UpdateResidual only while its block is in the window.
+  std::vector<ceres::CostFunction*> costs_;
   // Online calibration only (else empty / null): the keypoints in the lidar frame, the extrinsic
   // block and its value this round.
   std::vector<Vec3> points_lidar_;

@@ -66,6 +66,11 @@ struct LidarFrontendOptions {
   // Stop re-associating when the knots' poses move less than this between rounds.
   double convergence_translation = 1e-3;  // m
   double convergence_rotation = 1e-4;     // rad
+  // A keypoint that moved less than this in the map (at the current estimate) since the round
+  // that searched its plane keeps that plane in the next round instead of searching again (the
+  // kNN search and the plane fit are most of the association's cost, and a small move seldom
+  // changes the neighbours). 0 = search every round.
+  double reassociation_distance = 0.0;  // m
 
   // Throws std::invalid_argument naming the first bad field.
   void Validate() const;

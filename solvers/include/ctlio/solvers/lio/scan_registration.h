@@ -3,7 +3,12 @@
 //
 //   for each round (≤ max_iterations):
 //     associate  every keypoint, placed in the map by the current estimate, with a plane of the
-//                map (PlaneAssociator) and add its point-to-plane residual to the window;
+//                map (PlaneAssociator) and give it a point-to-plane residual in the window:
+//                a keypoint with a residual from an earlier round keeps its block with the new
+//                plane written into it (LidarTerm::UpdateResidual), one that lost its plane
+//                loses its block, a new one gets a block (LidarTerm::AddResidual) — the window
+//                is that of removing all and adding them again up to the order of its blocks,
+//                without Ceres' cost of removing and adding ~10³ blocks per round;
 //                fewer than min_associations: degenerate scan, the lidar term is dropped;
 //     solve      the window (solver_iterations Levenberg–Marquardt steps);
 //     converged? the newest pose moved less than convergence_translation/_rotation.
@@ -40,6 +45,11 @@ class LidarTerm {
   // Adds keypoint i's residual on the associated plane (weight already whitened) to the window.
   virtual ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
                                              ceres::LossFunction* loss, SlidingWindow* window) = 0;
+  // Keypoint i, whose residual AddResidual added in an earlier round of this registration and
+  // which is still in the window, is associated again: its residual measures `association` from
+  // now on (the cost function's set_association; between solves only). The residual block, its
+  // loss and its place in the window stay.
+  virtual void UpdateResidual(size_t i, const PlaneAssociation& association) = 0;
   // The pose whose change between rounds decides convergence (the newest state's).
   virtual SE3 NewestPose() const = 0;
 };
@@ -54,7 +64,8 @@ struct RegistrationSummary {
   bool degenerate = false;    // too few associations: the lidar term was dropped
   double ms_associate = 0.0;  // wall time of the association, all rounds
   double ms_solve = 0.0;      // wall time of the solves, all rounds
-  std::vector<ceres::ResidualBlockId> lidar_blocks;  // the last round's residuals (in the window)
+  // The last round's residuals (in the window), in keypoint order.
+  std::vector<ceres::ResidualBlockId> lidar_blocks;
 };
 
 // The robust loss of the point-to-plane residuals (cauchy/huber/none, SPEC §4): the residuals
