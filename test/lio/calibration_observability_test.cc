@@ -35,8 +35,14 @@ TEST(CalibrationObservability, WhitensByThePriorAndSumsOverTheHorizon) {
   ASSERT_EQ(obs.dimension(), 1);
   EXPECT_EQ(obs.names().front(), "time_offset_0");
   EXPECT_TRUE(obs.Unobservable().front());  // nothing measured yet
-  // 1/(10 ms)² per scan: ν = 0.03²/0.01² = 9 per scan.
+  // 1/(10 ms)² per scan: ν = 0.03²/0.01² = 9 per scan. With one of three scans in the horizon
+  // the threshold is a third: 0.2/scan is below, 9/scan above.
   const Eigen::MatrixXd I = Eigen::MatrixXd::Constant(1, 1, 1e4);
+  {
+    CalibrationObservability weak(Options(3, 1.0), 1, false);
+    weak.AddScan(Eigen::MatrixXd::Constant(1, 1, 0.2 / (0.03 * 0.03)));
+    EXPECT_TRUE(weak.Unobservable().front());
+  }
   obs.AddScan(I);
   EXPECT_NEAR(obs.whitened_information()[0], 9.0, 1e-9);
   EXPECT_FALSE(obs.Unobservable().front());

@@ -1,5 +1,6 @@
 #include "ctlio/solvers/lio/calibration_observability.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -64,9 +65,15 @@ void CalibrationObservability::AddScan(const Eigen::MatrixXd& information) {
 }
 
 std::vector<bool> CalibrationObservability::Unobservable() const {
+  // Until the horizon is full the threshold is scaled by its filled fraction (the same
+  // information per scan): holding a well-observed state for the first N scans, with a wrong
+  // start, costs accuracy for the rest of the run (the map of those scans stays).
+  const double filled =
+      static_cast<double>(horizon_.size()) / std::max(1, options_.observability_horizon_scans);
   std::vector<bool> out(static_cast<size_t>(dimension()));
   for (int i = 0; i < dimension(); ++i) {
-    out[static_cast<size_t>(i)] = horizon_.empty() || nu_[i] < threshold_[static_cast<size_t>(i)];
+    out[static_cast<size_t>(i)] =
+        horizon_.empty() || nu_[i] < std::min(filled, 1.0) * threshold_[static_cast<size_t>(i)];
   }
   return out;
 }

@@ -21,7 +21,8 @@
 //   ν_i = σ_prior,i² · (information on c_i from the horizon's measurements, everything else free),
 // i.e. how many priors' worth of information the last N scans carry about c_i (ν = 1: the
 // measurements alone would halve its variance). ν_i below its kind's threshold (clock offset,
-// extrinsic rotation, extrinsic translation: calibration_options.h) ⇒ c_i is unobservable.
+// extrinsic rotation, extrinsic translation: calibration_options.h) ⇒ c_i is unobservable; while
+// the horizon holds n < N scans the threshold is scaled by n/N (the same information per scan).
 #pragma once
 
 #include <Eigen/Core>
@@ -51,7 +52,8 @@ class CalibrationObservability {
   void AddScan(const Eigen::MatrixXd& information);
   // ν per coordinate over the horizon (zero before the first scan).
   const Eigen::VectorXd& whitened_information() const { return nu_; }
-  // ν_i below its kind's threshold (all true before the first scan: nothing has been measured).
+  // ν_i below its kind's threshold (× n/N while the horizon holds n < N scans; all true before
+  // the first scan: nothing has been measured).
   std::vector<bool> Unobservable() const;
 
  private:

@@ -31,7 +31,8 @@ struct CalibrationOptions {
   // coordinate is reported unobservable and, with `hold_unobservable`, held at its value during
   // the next scan's solve (a prior of whitened information `hold_information` along it), so that
   // it does not drift on the marginal priors' information alone. 0 scans: no check (the
-  // behaviour before). Thresholds set on the tuning sequences slow/100 and medium/100 (16 beams,
+  // behaviour before). While fewer than N scans were assessed the threshold is scaled by their
+  // number / N. Thresholds set on the tuning sequences slow/100 and medium/100 (16 beams,
   // every 4th firing, both calibrations from the wrong start, horizon 20), where ν per scan was
   // (slow / medium): δ 0.05 / 40, φ ≤ 8e-5 / ≥ 0.5, ρ ≤ 3e-7 / ≥ 1e-3 — one scan of 0.1 s with
   // its knots free says little about the lever arm even with rotation, so the kinds differ by
