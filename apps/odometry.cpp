@@ -356,6 +356,7 @@ int main(int argc, char** argv) {
         ev << "\n";
       }
       WriteExtrinsicEvaluation(run, ev);
+      lioapp::WriteObservabilitySummary(run, ev);
       if (!run.nees.empty()) {
         ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
            << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "

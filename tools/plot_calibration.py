@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Plots the odometry's online calibration over time (calibration.csv of ctlio_odometry --out):
-each estimate with its ±3σ band, and the truth when calibration.yaml states one (simulator).
+each estimate with its ±3σ band, the truth when calibration.yaml states one (simulator), and in
+grey the spans the observability check reported the coordinate unobservable.
 
 Usage: plot_calibration.py FOLDER [FOLDER ...]   (writes FOLDER/calibration.png)
 """
@@ -25,8 +26,26 @@ def read_columns(path):
     cols = {h: [] for h in header}
     for row in data:
         for h, v in zip(header, row):
-            cols[h].append(float(v) if v not in ("", "nan", "-nan") else math.nan)
+            if h.endswith("_status"):  # observable | unobservable | - (not assessed)
+                cols[h].append(v)
+            else:
+                cols[h].append(float(v) if v not in ("", "nan", "-nan") else math.nan)
     return cols
+
+
+def unobservable_spans(t, status):
+    """[(t_begin, t_end)] over which the observability check reported the coordinate
+    unobservable (held during the next scan)."""
+    spans, begin = [], None
+    for i, s in enumerate(status):
+        if s == "unobservable" and begin is None:
+            begin = t[i]
+        elif s != "unobservable" and begin is not None:
+            spans.append((begin, t[i]))
+            begin = None
+    if begin is not None:
+        spans.append((begin, t[-1]))
+    return spans
 
 
 def read_truth(folder):
@@ -75,29 +94,34 @@ def plot(folder):
         m = re.match(r"time_offset_(\d+)_s$", h)
         if m:
             series.append((f"IMU {m.group(1)} time offset [ms]", h,
-                           f"time_offset_{m.group(1)}_sigma_s", 1e3, int(m.group(1))))
+                           f"time_offset_{m.group(1)}_sigma_s", 1e3, int(m.group(1)),
+                           f"time_offset_{m.group(1)}_status"))
     # The extrinsic: its deviation from the starting value, [rho; phi] of T = Exp([rho; phi]) T_start.
     for a in "xyz":
         key = f"extrinsic_rho_{a}_m"
         if key in cols:
-            series.append((f"extrinsic rho_{a} [cm]", key, f"extrinsic_rho_{a}_sigma_m", 1e2, key))
+            series.append((f"extrinsic rho_{a} [cm]", key, f"extrinsic_rho_{a}_sigma_m", 1e2, key,
+                           f"extrinsic_rho_{a}_status"))
     for a in "xyz":
         key = f"extrinsic_phi_{a}_deg"
         if key in cols:
             series.append((f"extrinsic phi_{a} [deg]", key, f"extrinsic_phi_{a}_sigma_deg", 1.0,
-                           key))
+                           key, f"extrinsic_phi_{a}_status"))
     if not series:
         return
     truth = read_truth(folder)
     truth.update(read_extrinsic_truth(folder))
     fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
-    for ax, (label, key, sigma_key, scale, imu) in zip(axes[:, 0], series):
+    for ax, (label, key, sigma_key, scale, imu, status_key) in zip(axes[:, 0], series):
         est = [scale * v for v in cols[key]]
         sig = [scale * v for v in cols.get(sigma_key, [math.nan] * len(est))]
         ax.plot(t, est, color="tab:red", label="estimate")
         lo = [e - 3 * s for e, s in zip(est, sig)]
         hi = [e + 3 * s for e, s in zip(est, sig)]
         ax.fill_between(t, lo, hi, color="tab:red", alpha=0.2, label="±3σ")
+        # Grey: unobservable from the measurements of the horizon (held in the next scan).
+        for n, (b, e) in enumerate(unobservable_spans(t, cols.get(status_key, []))):
+            ax.axvspan(b, e, color="0.6", alpha=0.3, lw=0, label="unobservable" if n == 0 else None)
         if imu in truth:
             ax.axhline(scale * truth[imu], color="k", linestyle="--", label="truth")
         ax.set_ylabel(label)

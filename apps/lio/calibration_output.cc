@@ -1,5 +1,6 @@
 #include "lio/calibration_output.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -13,6 +14,64 @@ const lio::ScanResult* LastCalibration(const RunSummary& run) {
     if (!it->calibration.time_offset_s.empty() || it->calibration.has_extrinsic) return &*it;
   }
   return nullptr;
+}
+
+std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::CalibrationEstimate& c) {
+  std::vector<std::string> names;
+  for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+    names.push_back("time_offset_" + std::to_string(j));
+  }
+  if (c.has_extrinsic) {
+    for (const char* a : {"x", "y", "z"}) names.push_back(std::string("extrinsic_rho_") + a);
+    for (const char* a : {"x", "y", "z"}) names.push_back(std::string("extrinsic_phi_") + a);
+  }
+  return names;
+}
+
+void WriteObservabilitySummary(const RunSummary& run, std::ostream& out) {
+  const lio::ScanResult* last = LastCalibration(run);
+  if (last == nullptr || !HasObservability(run)) return;
+  const std::vector<std::string> names = CalibrationCoordinates(last->calibration);
+  const std::vector<double> fraction = UnobservableFraction(run);
+  const auto& c = last->calibration;
+  out << "calibration_unobservable_final";
+  bool none = true;
+  for (size_t i = 0; i < names.size() && i < c.unobservable.size(); ++i) {
+    if (!c.unobservable[i]) continue;
+    out << ' ' << names[i];
+    none = false;
+  }
+  out << (none ? " -\n" : "\n") << "calibration_information_final";
+  for (size_t i = 0; i < names.size() && i < c.observability.size(); ++i) {
+    out << ' ' << names[i] << '=' << c.observability[i];
+  }
+  out << "\ncalibration_unobservable_fraction";
+  for (size_t i = 0; i < names.size() && i < fraction.size(); ++i) {
+    out << ' ' << names[i] << '=' << fraction[i];
+  }
+  out << "\n";
+}
+
+bool HasObservability(const RunSummary& run) {
+  for (const lio::ScanResult& r : run.scans) {
+    if (!r.calibration.observability.empty()) return true;
+  }
+  return false;
+}
+
+std::vector<double> UnobservableFraction(const RunSummary& run) {
+  std::vector<double> fraction;
+  int assessed = 0;
+  for (const lio::ScanResult& r : run.scans) {
+    const auto& u = r.calibration.unobservable;
+    if (u.empty()) continue;
+    if (fraction.empty()) fraction.assign(u.size(), 0.0);
+    if (u.size() != fraction.size()) continue;
+    ++assessed;
+    for (size_t i = 0; i < u.size(); ++i) fraction[i] += u[i] ? 1.0 : 0.0;
+  }
+  for (double& x : fraction) x /= std::max(assessed, 1);
+  return fraction;
 }
 
 void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
@@ -34,6 +93,14 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
       f << ",extrinsic_phi_" << a << "_deg,extrinsic_phi_" << a << "_sigma_deg";
     }
   }
+  // Observability from the measurements alone (calibration_observability.h), per coordinate in
+  // the order above: ν over the horizon and whether it is below the threshold.
+  const std::vector<std::string> coordinates =
+      last != nullptr ? CalibrationCoordinates(last->calibration) : std::vector<std::string>();
+  const bool observability = HasObservability(run);
+  if (observability) {
+    for (const std::string& c : coordinates) f << ',' << c << "_information," << c << "_status";
+  }
   f << "\n" << std::setprecision(10);
   for (const lio::ScanResult& r : run.scans) {
     const auto& c = r.calibration;
@@ -51,6 +118,17 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
       const Vec6 sigma = c.extrinsic_sigma.isZero() ? Vec6::Constant(NAN) : c.extrinsic_sigma;
       for (int i = 0; i < 3; ++i) f << ',' << d[i] << ',' << sigma[i];
       for (int i = 3; i < 6; ++i) f << ',' << deg * d[i] << ',' << deg * sigma[i];
+    }
+    if (observability) {
+      // Not assessed (the initialising scan): NaN and "-".
+      for (size_t i = 0; i < coordinates.size(); ++i) {
+        if (i < c.observability.size() && i < c.unobservable.size()) {
+          f << ',' << c.observability[i] << ','
+            << (c.unobservable[i] ? "unobservable" : "observable");
+        } else {
+          f << ",nan,-";
+        }
+      }
     }
     f << "\n";
   }

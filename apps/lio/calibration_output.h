@@ -5,6 +5,7 @@
 #pragma once
 
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -15,8 +16,25 @@ namespace ctlio::lioapp {
 // The last scan that reports a calibration estimate (nullptr: none).
 const lio::ScanResult* LastCalibration(const RunSummary& run);
 
+// Names of the calibration coordinates of an estimate, in the order of its observability:
+// time_offset_<j> per IMU, then extrinsic_rho_<x|y|z>, extrinsic_phi_<x|y|z>.
+std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::CalibrationEstimate& c);
+// Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
+// unobservable after the last scan, or -), calibration_information_final (ν per coordinate) and
+// calibration_unobservable_fraction (per coordinate, of the assessed scans). Nothing without the
+// observability check.
+void WriteObservabilitySummary(const RunSummary& run, std::ostream& out);
+
+// Whether any scan carries the observability of the calibration (calibration_observability.h).
+bool HasObservability(const RunSummary& run);
+// Per calibration coordinate (as ScanResult::CalibrationEstimate::observability): the fraction
+// of the assessed scans after which it was unobservable (empty: never assessed).
+std::vector<double> UnobservableFraction(const RunSummary& run);
+
 // CSV, one row per scan with an estimate: t_s, then per IMU j time_offset_j_s,
-// time_offset_j_sigma_s (NaN σ: not computed), then the extrinsic's columns when estimated.
+// time_offset_j_sigma_s (NaN σ: not computed), then the extrinsic's columns when estimated, then
+// with the observability check per coordinate <name>_information (ν) and <name>_status
+// (observable | unobservable).
 // The write is checked (an error names the path).
 void WriteCalibrationLog(const std::string& path, const RunSummary& run);
 

@@ -94,6 +94,26 @@ TEST(OdometryConfig, CalibrationSection) {
   EXPECT_THROW(
       LoadOdometryConfig(WriteTemp("cal_s.yaml", "calibration:\n  time_offset_prior_sigma_s: 0\n")),
       std::runtime_error);
+  // The observability check's keys (calibration_observability.h).
+  const OdometryConfig o =
+      LoadOdometryConfig(WriteTemp("cal_o.yaml",
+                                   "calibration:\n  observability_horizon_scans: 7\n"
+                                   "  time_offset_observability_threshold: 2\n"
+                                   "  rotation_observability_threshold: 0.5\n"
+                                   "  translation_observability_threshold: 0.01\n"
+                                   "  hold_unobservable: false\n  hold_information: 1e6\n"));
+  EXPECT_EQ(o.calibration.observability_horizon_scans, 7);
+  EXPECT_DOUBLE_EQ(o.calibration.time_offset_observability_threshold, 2.0);
+  EXPECT_DOUBLE_EQ(o.calibration.rotation_observability_threshold, 0.5);
+  EXPECT_DOUBLE_EQ(o.calibration.translation_observability_threshold, 0.01);
+  EXPECT_FALSE(o.calibration.hold_unobservable);
+  EXPECT_DOUBLE_EQ(o.calibration.hold_information, 1e6);
+  EXPECT_THROW(LoadOdometryConfig(
+                   WriteTemp("cal_h.yaml", "calibration:\n  observability_horizon_scans: -1\n")),
+               std::runtime_error);
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp(
+                   "cal_t.yaml", "calibration:\n  rotation_observability_threshold: -1\n")),
+               std::runtime_error);
   EXPECT_THROW(LoadOdometryConfig(
                    WriteTemp("cal_pm.yaml", "per_method:\n  lidar_gyro:\n    calibration: {}\n")),
                std::runtime_error);

@@ -22,6 +22,15 @@ void CalibrationOptions::Validate() const {
           "calibration.extrinsic_prior_sigma_deg must be positive");
   require(std::isfinite(extrinsic_prior_sigma_m) && extrinsic_prior_sigma_m > 0,
           "calibration.extrinsic_prior_sigma_m must be positive");
+  require(observability_horizon_scans >= 0,
+          "calibration.observability_horizon_scans must be >= 0 (0: no check)");
+  for (double t : {time_offset_observability_threshold, rotation_observability_threshold,
+                   translation_observability_threshold}) {
+    require(std::isfinite(t) && t >= 0,
+            "calibration.*_observability_threshold must be finite and >= 0");
+  }
+  require(std::isfinite(hold_information) && hold_information > 0,
+          "calibration.hold_information must be positive");
 }
 
 }  // namespace ctlio::lio

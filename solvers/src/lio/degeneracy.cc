@@ -24,19 +24,23 @@ std::string DegeneracyReport::DirectionString() const {
 
 namespace {
 
-// The ordering of Linearize: `pose` first, then every other non-constant state the residuals
-// touch, in ascending id (deterministic).
+// The ordering of Linearize: `leading` first (in that order, constant or not), then every other
+// non-constant state the residuals touch, in ascending id (deterministic).
 std::vector<StateId> Ordering(const SlidingWindow& window,
-                              const std::vector<ceres::ResidualBlockId>& residuals, StateId pose) {
+                              const std::vector<ceres::ResidualBlockId>& residuals,
+                              const std::vector<StateId>& leading) {
   std::vector<StateId> ids;
   for (const ceres::ResidualBlockId r : residuals) {
     for (const StateId id : window.StatesOf(r)) {
-      if (id != pose && !window.IsStateConstant(id)) ids.push_back(id);
+      if (std::find(leading.begin(), leading.end(), id) == leading.end() &&
+          !window.IsStateConstant(id)) {
+        ids.push_back(id);
+      }
     }
   }
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  ids.insert(ids.begin(), pose);
+  ids.insert(ids.begin(), leading.begin(), leading.end());
   return ids;
 }
 
@@ -60,7 +64,7 @@ Mat6 PoseInformation(const SlidingWindow& window,
   if (window.IsStateConstant(pose)) return Mat6::Zero();
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
-  window.Linearize(residuals, Ordering(window, residuals, pose), &H, &b);
+  window.Linearize(residuals, Ordering(window, residuals, {pose}), &H, &b);
   return ToBody(H.topLeftCorner<6, 6>(), A);
 }
 
@@ -77,15 +81,22 @@ Mat6 OtherInformation(const SlidingWindow& window,
     }
   }
   if (others.empty()) return Mat6::Zero();
-  const std::vector<StateId> ordering = Ordering(window, others, pose);
+  return ToBody(MarginalInformation(window, others, {pose}), A);
+}
+
+Eigen::MatrixXd MarginalInformation(const SlidingWindow& window,
+                                    const std::vector<ceres::ResidualBlockId>& residuals,
+                                    const std::vector<StateId>& states) {
+  const std::vector<StateId> ordering = Ordering(window, residuals, states);
   Eigen::MatrixXd H;
   Eigen::VectorXd b;
-  window.Linearize(others, ordering, &H, &b);
-  std::vector<int> keep(6), marginalize;
-  for (int i = 0; i < 6; ++i) keep[i] = i;
-  for (int i = 6; i < H.rows(); ++i) marginalize.push_back(i);
-  const SchurComplementResult s = SchurComplement(H, b, keep, marginalize);
-  return ToBody(s.information, A);
+  window.Linearize(residuals, ordering, &H, &b);
+  int n = 0;
+  for (const StateId id : states) n += window.TangentSize(id);
+  std::vector<int> keep(n), marginalize;
+  for (int i = 0; i < n; ++i) keep[i] = i;
+  for (int i = n; i < H.rows(); ++i) marginalize.push_back(i);
+  return SchurComplement(H, b, keep, marginalize).information;
 }
 
 DegeneracyReport AnalyseDegeneracy(const Mat6& H, const DegeneracyOptions& options) {

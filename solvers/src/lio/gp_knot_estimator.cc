@@ -55,11 +55,22 @@ GpKnotEstimator::Knot GpKnotEstimator::AddKnot(double t, const SE3& T_rm, const 
   return k;
 }
 
+namespace {
+
+std::vector<StateId> KeysOf(const KnotKeys& keys, size_t num_bias) {
+  std::vector<StateId> out = keys.Motion();
+  for (size_t j = 0; j < num_bias; ++j) out.push_back(keys.Bias(static_cast<int>(j)));
+  return out;
+}
+
+}  // namespace
+
 std::vector<StateId> GpKnotEstimator::OldestKeys() const {
-  const Knot& k = knots_.front();
-  std::vector<StateId> keys = k.keys.Motion();
-  for (size_t j = 0; j < k.bias.size(); ++j) keys.push_back(k.keys.Bias(static_cast<int>(j)));
-  return keys;
+  return KeysOf(knots_.front().keys, knots_.front().bias.size());
+}
+
+std::vector<StateId> GpKnotEstimator::NewestKeys() const {
+  return KeysOf(knots_.back().keys, knots_.back().bias.size());
 }
 
 SE3 GpKnotEstimator::PoseAt(const Knot& a, const Knot& b, double tau) const {

@@ -9,9 +9,12 @@
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_set>
 
+#include "ctlio/factors/priors/euclidean_prior.h"
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/state_keys.h"
@@ -205,8 +208,10 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const SE3 predicted = window_.Pose(estimator_->NewestPoseKey());
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
+  HoldUnobservableCalibration(result);
   const RegistrationSummary registered =
       registration_.Register(frontend_.map(), lidar.get(), &window_);
+  ReleaseCalibration();
   if (!registered.degenerate) AnalyseDegeneracy(registered, predicted, result);
   result->rounds = registered.rounds;
   result->solver_iterations = registered.solver_iterations;
@@ -224,7 +229,84 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->ms_map = MsSince(t_map);
   estimator_->Report(result);
   if (config_.pose_covariance) ReportPoseCovariance(result);
-  if (config_.calibration.any()) ReportCalibrationCovariance(result);
+  if (config_.calibration.any()) {
+    AssessCalibrationObservability(result);
+    ReportCalibrationCovariance(result);
+  }
+}
+
+void LioOdometry::AssessCalibrationObservability(ScanResult* result) {
+  if (!StartObservability()) return;
+  // The newest interval's factors: every residual block on a state of the newest knot.
+  std::vector<ceres::ResidualBlockId> newest;
+  std::unordered_set<ceres::ResidualBlockId> seen;
+  for (const StateId id : estimator_->NewestKeys()) {
+    for (const ceres::ResidualBlockId r : window_.ResidualBlocksOf(id)) {
+      if (seen.insert(r).second) newest.push_back(r);
+    }
+  }
+  observability_->AddScan(MarginalInformation(window_, newest, calibration_states_));
+  const Eigen::VectorXd& nu = observability_->whitened_information();
+  result->calibration.observability.assign(nu.data(), nu.data() + nu.size());
+  result->calibration.unobservable = observability_->Unobservable();
+}
+
+bool LioOdometry::StartObservability() {
+  if (observability_ != nullptr) return true;
+  if (config_.calibration.observability_horizon_scans == 0) return false;
+  // The calibration states the estimator keeps (the baseline has none), in the order of the
+  // coordinates: the clock offsets, then the extrinsic.
+  int offsets = 0;
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    if (!window_.HasState(TimeOffsetKey(j))) continue;
+    calibration_states_.push_back(TimeOffsetKey(j));
+    ++offsets;
+  }
+  const bool extrinsic = window_.HasState(kExtrinsicKey);
+  if (extrinsic) calibration_states_.push_back(kExtrinsicKey);
+  if (calibration_states_.empty()) return false;
+  observability_ =
+      std::make_unique<CalibrationObservability>(config_.calibration, offsets, extrinsic);
+  return true;
+}
+
+void LioOdometry::HoldUnobservableCalibration(ScanResult* result) {
+  // Before any assessment everything is unobservable (nothing measured yet): held too.
+  if (!config_.calibration.any() || !config_.calibration.hold_unobservable ||
+      !StartObservability()) {
+    return;
+  }
+  const std::vector<bool> hold = observability_->Unobservable();
+  result->calibration.held = hold;
+  // A prior at the current value along each unobservable coordinate, σ_hold = σ_prior/√w: the
+  // solve moves it by a negligible amount; removed again before anything else reads the window.
+  const double w = std::sqrt(config_.calibration.hold_information);
+  const Eigen::VectorXd& sigma = observability_->prior_sigma();
+  int i = 0;
+  for (const StateId id : calibration_states_) {
+    if (id == kExtrinsicKey) {
+      Mat6 sqrt_information = Mat6::Zero();
+      for (int a = 0; a < 6; ++a, ++i) {
+        if (hold[static_cast<size_t>(i)]) sqrt_information(a, a) = w / sigma[i];
+      }
+      if (sqrt_information.isZero()) continue;
+      holds_.push_back(window_.AddResidualBlock(
+          new PosePrior(window_.Pose(kExtrinsicKey), sqrt_information), nullptr, {id}));
+      continue;
+    }
+    if (hold[static_cast<size_t>(i)]) {
+      holds_.push_back(window_.AddResidualBlock(
+          new EuclideanPrior<1>(Eigen::Matrix<double, 1, 1>(window_.State(id)[0]),
+                                Eigen::Matrix<double, 1, 1>(w / sigma[i])),
+          nullptr, {id}));
+    }
+    ++i;
+  }
+}
+
+void LioOdometry::ReleaseCalibration() {
+  for (const ceres::ResidualBlockId r : holds_) window_.RemoveResidualBlock(r);
+  holds_.clear();
 }
 
 void LioOdometry::ReportPoseCovariance(ScanResult* result) {

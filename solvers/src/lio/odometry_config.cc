@@ -223,13 +223,22 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"remap", SetFromYaml(&c->degeneracy.remap)}});
     } else if (key == "calibration") {
       CalibrationOptions& o = c->calibration;
-      ReadSection(v, section, source,
-                  {{"estimate_time_offset", SetFromYaml(&o.estimate_time_offset)},
-                   {"time_offset_s", SetFromYaml(&o.time_offset_s)},
-                   {"time_offset_prior_sigma_s", SetFromYaml(&o.time_offset_prior_sigma_s)},
-                   {"estimate_extrinsic", SetFromYaml(&o.estimate_extrinsic)},
-                   {"extrinsic_prior_sigma_deg", SetFromYaml(&o.extrinsic_prior_sigma_deg)},
-                   {"extrinsic_prior_sigma_m", SetFromYaml(&o.extrinsic_prior_sigma_m)}});
+      ReadSection(
+          v, section, source,
+          {{"estimate_time_offset", SetFromYaml(&o.estimate_time_offset)},
+           {"time_offset_s", SetFromYaml(&o.time_offset_s)},
+           {"time_offset_prior_sigma_s", SetFromYaml(&o.time_offset_prior_sigma_s)},
+           {"estimate_extrinsic", SetFromYaml(&o.estimate_extrinsic)},
+           {"extrinsic_prior_sigma_deg", SetFromYaml(&o.extrinsic_prior_sigma_deg)},
+           {"extrinsic_prior_sigma_m", SetFromYaml(&o.extrinsic_prior_sigma_m)},
+           {"observability_horizon_scans", SetFromYaml(&o.observability_horizon_scans)},
+           {"time_offset_observability_threshold",
+            SetFromYaml(&o.time_offset_observability_threshold)},
+           {"rotation_observability_threshold", SetFromYaml(&o.rotation_observability_threshold)},
+           {"translation_observability_threshold",
+            SetFromYaml(&o.translation_observability_threshold)},
+           {"hold_unobservable", SetFromYaml(&o.hold_unobservable)},
+           {"hold_information", SetFromYaml(&o.hold_information)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

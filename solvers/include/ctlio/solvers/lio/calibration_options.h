@@ -24,6 +24,27 @@ struct CalibrationOptions {
   double extrinsic_prior_sigma_deg = 5.0;  // σ of the prior per rotation axis
   double extrinsic_prior_sigma_m = 0.2;    // σ of the prior per translation axis
 
+  // Observability from the measurements alone (calibration_observability.h): the information on
+  // each calibration coordinate (δ_j; the extrinsic's ρ_x … φ_z) from the factors of the newest
+  // interval only, summed over the last `observability_horizon_scans` scans and whitened by the
+  // prior σ (ν: how many priors' worth of information). Below the kind's threshold the
+  // coordinate is reported unobservable and, with `hold_unobservable`, held at its value during
+  // the next scan's solve (a prior of whitened information `hold_information` along it), so that
+  // it does not drift on the marginal priors' information alone. 0 scans: no check (the
+  // behaviour before). While fewer than N scans were assessed the threshold is scaled by their
+  // number / N. Thresholds set on the tuning sequences slow/100 and medium/100 (16 beams,
+  // every 4th firing, both calibrations from the wrong start, horizon 20), where ν per scan was
+  // (slow / medium): δ 0.05 / 40, φ ≤ 8e-5 / ≥ 0.5, ρ ≤ 3e-7 / ≥ 1e-3 — one scan of 0.1 s with
+  // its knots free says little about the lever arm even with rotation, so the kinds differ by
+  // orders of magnitude; each threshold sits between the two regimes' horizon values (README
+  // "Online calibration").
+  int observability_horizon_scans = 20;
+  double time_offset_observability_threshold = 10.0;
+  double rotation_observability_threshold = 0.1;
+  double translation_observability_threshold = 1e-3;
+  bool hold_unobservable = true;
+  double hold_information = 1e8;  // whitened (σ_hold = σ_prior / 1e4)
+
   // δ_j's configured value (0 when the list is empty).
   double TimeOffset(int j) const {
     return time_offset_s.empty() ? 0.0 : time_offset_s[static_cast<std::size_t>(j)];

@@ -94,6 +94,13 @@ Mat6 OtherInformation(const SlidingWindow& window,
                       const std::vector<ceres::ResidualBlockId>& excluded, StateId pose,
                       const Mat6& A);
 
+// Information of `residuals` on the tangents of `states` (in that order, constant or not), every
+// other non-constant state they touch marginalised (Schur complement): what these residuals alone
+// say about `states`. OtherInformation is this on one pose, moved into the body frame.
+Eigen::MatrixXd MarginalInformation(const SlidingWindow& window,
+                                    const std::vector<ceres::ResidualBlockId>& residuals,
+                                    const std::vector<StateId>& states);
+
 // The eigen-analysis of a body-frame lidar information H (6×6, [ρ; φ]).
 DegeneracyReport AnalyseDegeneracy(const Mat6& H, const DegeneracyOptions& options);
 

@@ -53,6 +53,8 @@ class Estimator {
   // and forgetting it once the window has marginalised it.
   virtual int num_states() const = 0;
   virtual std::vector<StateId> OldestKeys() const = 0;
+  // The keys of the newest state (its residual blocks are the newest interval's factors).
+  virtual std::vector<StateId> NewestKeys() const = 0;
   virtual void DropOldest() = 0;
   // Time (odometry seconds) and map pose T_mr of the newest and the previous state.
   virtual double newest_time() const = 0;

@@ -43,6 +43,7 @@ class GpKnotEstimator final : public Estimator {
 
   int num_states() const override { return static_cast<int>(knots_.size()); }
   std::vector<StateId> OldestKeys() const override;
+  std::vector<StateId> NewestKeys() const override;
   void DropOldest() override { knots_.pop_front(); }
   double newest_time() const override { return knots_.back().t; }
   SE3 NewestPose() const override;

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "ctlio/solvers/lio/calibration_observability.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/imu_buffer.h"
@@ -92,6 +93,18 @@ class LioOdometry {
   // With online calibration: the marginal σ of the calibration states (clock offsets, extrinsic;
   // one ceres::Covariance of the window, as ReportPoseCovariance) into result->calibration.
   void ReportCalibrationCovariance(ScanResult* result);
+  // With online calibration and calibration.observability_horizon_scans > 0: the newest
+  // interval's information on the calibration coordinates into the horizon
+  // (calibration_observability.h), ν and the unobservable ones into result->calibration.
+  void AssessCalibrationObservability(ScanResult* result);
+  // Before the registration: a strong prior at the current value along every coordinate the
+  // previous scan left unobservable (calibration.hold_unobservable), so that the solve does not
+  // move it; ReleaseCalibration removes them after the solve.
+  void HoldUnobservableCalibration(ScanResult* result);
+  void ReleaseCalibration();
+  // Creates observability_ over the calibration states in the window; false when there are none
+  // or the check is off.
+  bool StartObservability();
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
@@ -122,6 +135,11 @@ class LioOdometry {
   bool initialised_ = false;
   std::vector<ScanResult> results_;
   MarginalizationReport last_marginalization_;
+  // Online calibration's observability (created at the first assessment) over the states
+  // calibration_states_ (clock offsets, then the extrinsic), and the hold priors of this scan.
+  std::unique_ptr<CalibrationObservability> observability_;
+  std::vector<StateId> calibration_states_;
+  std::vector<ceres::ResidualBlockId> holds_;
   int num_marginalizations_ = 0;
 };
 

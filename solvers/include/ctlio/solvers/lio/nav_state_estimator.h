@@ -36,6 +36,7 @@ class NavStateEstimator final : public Estimator {
 
   int num_states() const override { return static_cast<int>(states_.size()); }
   std::vector<StateId> OldestKeys() const override { return states_.front().keys.All(); }
+  std::vector<StateId> NewestKeys() const override { return states_.back().keys.All(); }
   void DropOldest() override { states_.pop_front(); }
   double newest_time() const override { return states_.back().t; }
   SE3 NewestPose() const override;

@@ -214,6 +214,12 @@ struct ScanResult {
     bool has_extrinsic = false;
     SE3 T_imu_lidar;
     Vec6 extrinsic_sigma = Vec6::Zero();  // marginal σ, [ρ; φ] (m, rad)
+    // Observability from the measurements alone (calibration_observability.h), per coordinate
+    // [δ_0 … δ_{J−1}, then ρ_x, ρ_y, ρ_z, φ_x, φ_y, φ_z with the extrinsic]; empty when not
+    // assessed (calibration.observability_horizon_scans = 0, the initialising scan).
+    std::vector<double> observability;  // ν over the horizon after this scan (whitened)
+    std::vector<bool> unobservable;     // ν < threshold: held during the next scan's solve
+    std::vector<bool> held;             // held during this scan's solve
   } calibration;
 };
 
