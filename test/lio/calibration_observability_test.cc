@@ -100,6 +100,7 @@ lioapp::RunSummary RunBoth(sim::Regime regime, double duration_s) {
   OdometryConfig config = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
   config.calibration.estimate_time_offset = true;
   config.calibration.estimate_extrinsic = true;
+  config.calibration.hold_unobservable = true;  // off by default; the slow test checks the hold
   sim::SimulatedSource source(c);
   return lioapp::RunOdometry(source, config);
 }

@@ -42,7 +42,10 @@ struct CalibrationOptions {
   double time_offset_observability_threshold = 10.0;
   double rotation_observability_threshold = 0.1;
   double translation_observability_threshold = 1e-3;
-  bool hold_unobservable = true;
+  // Off by default: on the joint runs (README "Online calibration") holding cost ATE in every
+  // regime (medium 0.71 vs 0.60 cm, fast 2.14 vs 1.57, slow 29.3 / 10.0 vs 6.9 / 3.5 cm, the
+  // wrong start being held), so the check reports and the user decides.
+  bool hold_unobservable = false;
   double hold_information = 1e8;  // whitened (σ_hold = σ_prior / 1e4)
 
   // δ_j's configured value (0 when the list is empty).
