@@ -4,7 +4,6 @@
 
 namespace ctlio::imu {
 
-using internal::Jac3x6;
 using internal::WriteKnotJacobians;
 
 ImuAccelMeasurementWithTimeOffset::ImuAccelMeasurementWithTimeOffset(
@@ -24,10 +23,7 @@ bool ImuAccelMeasurementWithTimeOffset::Evaluate(double const* const* parameters
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const Mat3 C_mi = RotationManifold::Rotation(parameters[8]);
   const double delta = parameters[9][0];
-  bool need_knots = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
-  }
+  const bool need_knots = internal::NeedsKnotJacobians(jacobians);
   const bool need_rate = jacobians != nullptr && jacobians[9] != nullptr;
   internal::TimeShiftedState st;
   internal::InterpolateShifted(model_, t_k_, t_k1_, stamp_, delta, residual_.rows(), parameters,
@@ -45,12 +41,7 @@ bool ImuAccelMeasurementWithTimeOffset::Evaluate(double const* const* parameters
     WriteKnotJacobians(residual_.Chain(lin, st.J_k1), parameters[3], jacobians[3], jacobians[4],
                        jacobians[5]);
   }
-  for (int i = 0; i < 2; ++i) {
-    if (jacobians[6 + i] == nullptr) continue;
-    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
-    J.leftCols<3>() = -(i == 0 ? 1.0 - s : s) * residual_.sqrt_information();
-    J.rightCols<3>().setZero();
-  }
+  internal::WriteBiasJacobians(residual_.sqrt_information(), s, 0, jacobians[6], jacobians[7]);
   if (jacobians[8] != nullptr) {
     LiftRotationJacobian<3>(residual_.GravityJacobian(lin), parameters[8], jacobians[8]);
   }

@@ -2,7 +2,6 @@
 
 namespace ctlio::imu {
 
-using internal::Jac3x6;
 using internal::WriteKnotJacobians;
 
 ImuGyroMeasurementWithTimeOffset::ImuGyroMeasurementWithTimeOffset(const gp::SingerModel<6>& model,
@@ -19,10 +18,7 @@ bool ImuGyroMeasurementWithTimeOffset::Evaluate(double const* const* parameters,
                                                 double** jacobians) const {
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const double delta = parameters[8][0];
-  bool need_knots = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
-  }
+  const bool need_knots = internal::NeedsKnotJacobians(jacobians);
   const bool need_rate = jacobians != nullptr && jacobians[8] != nullptr;
   const unsigned rows = gp::kAngularVelocityRows;
   internal::TimeShiftedState st;
@@ -39,12 +35,7 @@ bool ImuGyroMeasurementWithTimeOffset::Evaluate(double const* const* parameters,
     WriteKnotJacobians(residual_.Chain(st.J_k1), parameters[3], jacobians[3], jacobians[4],
                        jacobians[5]);
   }
-  for (int i = 0; i < 2; ++i) {
-    if (jacobians[6 + i] == nullptr) continue;
-    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
-    J.leftCols<3>().setZero();
-    J.rightCols<3>() = -(i == 0 ? 1.0 - s : s) * residual_.sqrt_information();
-  }
+  internal::WriteBiasJacobians(residual_.sqrt_information(), s, 3, jacobians[6], jacobians[7]);
   if (need_rate) {
     // ∂e/∂δ = D·ẋ(τ) − S·db_g/dτ.
     Eigen::Map<Vec3>{jacobians[8]} =

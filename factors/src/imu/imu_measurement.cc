@@ -7,7 +7,6 @@
 namespace ctlio::imu {
 namespace {
 
-using internal::Jac3x6;
 using internal::Row3x18;
 using internal::WriteKnotJacobians;
 
@@ -41,10 +40,7 @@ ImuGyroMeasurement::ImuGyroMeasurement(std::shared_ptr<gp::SharedStateInterpolat
 bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
-  const bool need_knots =
-      jacobians != nullptr &&
-      (jacobians[0] != nullptr || jacobians[1] != nullptr || jacobians[2] != nullptr ||
-       jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
+  const bool need_knots = internal::NeedsKnotJacobians(jacobians);
   gp::SharedStateInterpolation::Result scratch;  // only the ϖ_ω rows are read
   const gp::SharedStateInterpolation::Result& interpolated =
       state_->State(parameters, Rows(), need_knots, &scratch);
@@ -59,12 +55,7 @@ bool ImuGyroMeasurement::Evaluate(double const* const* parameters, double* resid
     WriteKnotJacobians(residual_.Chain(interpolated.J_k1), parameters[3], jacobians[3],
                        jacobians[4], jacobians[5]);
   }
-  for (int i = 0; i < 2; ++i) {
-    if (jacobians[6 + i] == nullptr) continue;
-    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
-    J.leftCols<3>().setZero();
-    J.rightCols<3>() = -(i == 0 ? 1.0 - s_ : s_) * residual_.sqrt_information();
-  }
+  internal::WriteBiasJacobians(residual_.sqrt_information(), s_, 3, jacobians[6], jacobians[7]);
   return true;
 }
 
@@ -86,10 +77,7 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
                                    double** jacobians) const {
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const Mat3 C_mi = RotationManifold::Rotation(parameters[8]);
-  bool need_knots = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 6; ++i) need_knots = need_knots || jacobians[i] != nullptr;
-  }
+  const bool need_knots = internal::NeedsKnotJacobians(jacobians);
   // Only the rows D reads (residual_.rows()) are read.
   gp::SharedStateInterpolation::Result scratch;
   const gp::SharedStateInterpolation::Result& interpolated =
@@ -107,12 +95,7 @@ bool ImuAccelMeasurement::Evaluate(double const* const* parameters, double* resi
     WriteKnotJacobians(residual_.Chain(lin, interpolated.J_k1), parameters[3], jacobians[3],
                        jacobians[4], jacobians[5]);
   }
-  for (int i = 0; i < 2; ++i) {
-    if (jacobians[6 + i] == nullptr) continue;
-    Eigen::Map<Jac3x6> J{jacobians[6 + i]};
-    J.leftCols<3>() = -(i == 0 ? 1.0 - s_ : s_) * residual_.sqrt_information();
-    J.rightCols<3>().setZero();
-  }
+  internal::WriteBiasJacobians(residual_.sqrt_information(), s_, 0, jacobians[6], jacobians[7]);
   if (jacobians[8] != nullptr) {
     LiftRotationJacobian<3>(residual_.GravityJacobian(lin), parameters[8], jacobians[8]);
   }

@@ -40,6 +40,28 @@ inline void WriteKnotJacobians(const Row3x18& DJ, const double* pose, double* j_
   if (j_acc != nullptr) Eigen::Map<Jac3x6>{j_acc} = DJ.rightCols<6>();
 }
 
+// Whether Ceres asks for any of the two knots' Jacobians (blocks 0–5: pose, ϖ, ϖ̇ of each).
+inline bool NeedsKnotJacobians(double const* const* jacobians) {
+  if (jacobians == nullptr) return false;
+  for (int i = 0; i < 6; ++i) {
+    if (jacobians[i] != nullptr) return true;
+  }
+  return false;
+}
+
+// The knots' bias blocks [b_a; b_g]: the residual reads b(τ) = (1 − s)·b_k + s·b_{k+1} through
+// −S on three columns (first_col 0: the accelerometer's, 3: the gyro's); the others are zero.
+inline void WriteBiasJacobians(const Mat3& S, double s, int first_col, double* j_b_k,
+                               double* j_b_k1) {
+  double* const j[2] = {j_b_k, j_b_k1};
+  for (int i = 0; i < 2; ++i) {
+    if (j[i] == nullptr) continue;
+    Eigen::Map<Jac3x6> J{j[i]};
+    J.setZero();
+    J.middleCols<3>(first_col) = -(i == 0 ? 1.0 - s : s) * S;
+  }
+}
+
 // e_g = S(ω_m + C_ir ϖ_ω(τ) − b_g(τ)).
 class GyroResidual {
  public:
