@@ -187,13 +187,14 @@ void WriteBarSvg(const std::string& path,
 
 // OUT/extrinsic.csv: per run with a perturbed nominal or an estimated extrinsic, the starting
 // and final extrinsic errors against the truth (rotation [deg], translation [cm]), the final
-// marginal σ per axis ([ρ] cm, [φ] deg) and whether the error lies within 3σ on every axis, and the
-// ATE (sim/extrinsic_error.h).
+// marginal σ per axis ([ρ] cm, [φ] deg) and whether the error lies within 3σ on every axis, the
+// ATE (sim/extrinsic_error.h), and with a calibration warm-up replay the scans it revised and the
+// ATE of the trajectory as returned live (RunSummary::live_ate; = ate_m without a replay).
 void WriteExtrinsicErrors(const std::string& out, const std::vector<Job>& jobs) {
   std::ostringstream csv;
   csv << "regime,sequence,method,ate_m,initial_error_deg,initial_error_cm,error_deg,error_cm,"
          "sigma_x_cm,sigma_y_cm,sigma_z_cm,sigma_rx_deg,sigma_ry_deg,sigma_rz_deg,"
-         "rotation_within_3sigma,translation_within_3sigma\n";
+         "rotation_within_3sigma,translation_within_3sigma,warmup_replayed_scans,live_ate_m\n";
   bool any = false;
   for (const Job& j : jobs) {
     if (!j.done || !j.run.true_extrinsic) continue;
@@ -213,10 +214,12 @@ void WriteExtrinsicErrors(const std::string& out, const std::vector<Job>& jobs) 
     if (run.extrinsic_estimated) {
       const sim::SigmaCoverage c = sim::CoveredBySigma(run.final_extrinsic, *run.true_extrinsic, s);
       for (int i = 0; i < 6; ++i) csv << ',' << s[i] * (i < 3 ? 100.0 : 180.0 / M_PI);
-      csv << ',' << c.rotation << ',' << c.translation << "\n";
+      csv << ',' << c.rotation << ',' << c.translation;
     } else {
-      csv << ",,,,,,,,\n";
+      csv << ",,,,,,,,";
     }
+    csv << ',' << run.warmup_replayed_scans << ',' << (run.live_ate ? run.live_ate->rmse : NAN)
+        << "\n";
   }
   if (any) io::WriteTextFile(out + "/extrinsic.csv", csv.str());
 }

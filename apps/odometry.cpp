@@ -365,6 +365,9 @@ int main(int argc, char** argv) {
       if (run.ate) {
         ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
            << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
+        // calibration.warmup_replay_s: the live output's ATE, before the replay revised its start.
+        ev << "warmup_replayed_scans " << run.warmup_replayed_scans << "\n";
+        if (run.live_ate) ev << "live_ate_rmse_m " << run.live_ate->rmse << "\n";
         if (!run.dense.empty()) {
           ev << "dense_ate_rmse_m " << lioapp::EvaluateAte(run.dense, *source->GroundTruth()).rmse
              << "\ndense_poses " << run.dense.size() << "\n";

@@ -171,6 +171,57 @@ void PoseNees(const std::vector<lio::ScanResult>& scans, const std::vector<io::S
   }
 }
 
+// T_world_lidar of a scan: T_mr with the extrinsic estimated at that scan when it is estimated,
+// else the run's.
+SE3 LidarPose(const lio::ScanResult& r, const SE3& T_imu_lidar) {
+  return r.T_mr * (r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar);
+}
+
+// One scan's result into the summary: the counts by status, the trajectory (the lidar pose with
+// the extrinsic estimated at that scan, when it is estimated), biases and extrinsic, the log.
+// `index` counts the scans from 0: a failure of the first (initialisation) is not a failed scan.
+void Tally(const lio::ScanResult& r, size_t index, const SE3& T_imu_lidar, RunSummary* run) {
+  if (r.status == lio::ScanStatus::kSuspect) ++run->constant_imu_scans;
+  switch (r.status) {
+    case lio::ScanStatus::kFailed:
+      if (index > 0) {
+        ++run->failed;
+        if (run->first_failure.empty()) run->first_failure = r.message;
+      }
+      break;
+    case lio::ScanStatus::kDegenerate:
+      ++run->degenerate;
+      break;
+    case lio::ScanStatus::kImuGap:
+      ++run->imu_gaps;
+      break;
+    default:
+      break;
+  }
+  if (r.degeneracy.num_degenerate() > 0) ++run->degenerate_direction_scans;
+  if (r.status != lio::ScanStatus::kFailed) {
+    if (!r.imu_biases.empty()) run->final_biases = r.imu_biases;
+    if (r.calibration.has_extrinsic) {
+      run->extrinsic_estimated = true;
+      run->final_extrinsic = r.calibration.T_imu_lidar;
+      run->final_extrinsic_sigma = r.calibration.extrinsic_sigma;
+    }
+    run->trajectory.push_back({r.t_ns, LidarPose(r, T_imu_lidar)});
+  }
+  run->scans.push_back(r);
+}
+
+// Undoes every Tally (and the dense samples taken with them).
+void ResetTally(RunSummary* run) {
+  run->constant_imu_scans = run->failed = run->degenerate = run->imu_gaps = 0;
+  run->degenerate_direction_scans = 0;
+  run->first_failure.clear();
+  run->final_biases.clear();
+  run->trajectory.clear();
+  run->dense.clear();
+  run->scans.clear();
+}
+
 }  // namespace
 
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
@@ -226,6 +277,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                            : source.NumScans();
   io::ScanFrame frame;
   std::vector<double> ms;
+  SE3 live_from_replay;  // identity until a calibration warm-up replay
   size_t done = 0;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
     for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
@@ -245,7 +297,6 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     const lio::ScanResult r = odometry->AddScan(scan);
     run.imu_rejected += r.imu_rejected;
     run.points_dropped += r.points_dropped;
-    if (r.status == lio::ScanStatus::kSuspect) ++run.constant_imu_scans;
     if (r.imu_rejected > 0 || r.points_dropped > 0 || r.status == lio::ScanStatus::kSuspect) {
       warn("scan " + std::to_string(frame.index) + ": " + r.message);
     }
@@ -253,40 +304,38 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     previous_end = frame.end_ns;
     ++done;
     ms.push_back(r.milliseconds);
-    switch (r.status) {
-      case lio::ScanStatus::kFailed:
-        if (odometry->initialised() || done > 1) {
-          ++run.failed;
-          if (run.first_failure.empty()) run.first_failure = r.message;
-        }
-        break;
-      case lio::ScanStatus::kDegenerate:
-        ++run.degenerate;
-        break;
-      case lio::ScanStatus::kImuGap:
-        ++run.imu_gaps;
-        break;
-      default:
-        break;
+    if (r.revised_scans > 0) {
+      // The replay's map frame is its first scan placed with the warm-up's extrinsic, not the
+      // live one's: the live output continues in the live frame through the trigger scan's two
+      // estimates of the same lidar pose.
+      const lio::ScanResult& live = odometry->warmup_results().back();
+      if (live.status != lio::ScanStatus::kFailed && r.status != lio::ScanStatus::kFailed) {
+        live_from_replay = LidarPose(live, T_imu_lidar) * LidarPose(r, T_imu_lidar).Inverse();
+      }
     }
-    if (r.degeneracy.num_degenerate() > 0) ++run.degenerate_direction_scans;
     if (r.status != lio::ScanStatus::kFailed) {
-      if (!r.imu_biases.empty()) run.final_biases = r.imu_biases;
-      // The lidar pose with the extrinsic estimated at this scan, when it is estimated.
-      const SE3& T_rl = r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar;
-      if (r.calibration.has_extrinsic) {
-        run.extrinsic_estimated = true;
-        run.final_extrinsic = r.calibration.T_imu_lidar;
-        run.final_extrinsic_sigma = r.calibration.extrinsic_sigma;
-      }
-      run.trajectory.push_back({r.t_ns, r.T_mr * T_rl});
-      if (options.trajectory_rate_hz > 0.0) {
-        auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
-        if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
-        for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_rl});
-      }
+      run.live_trajectory.push_back({r.t_ns, live_from_replay * LidarPose(r, T_imu_lidar)});
     }
-    run.scans.push_back(r);
+    if (r.revised_scans > 0) {
+      // The calibration warm-up replay replaced the earlier scans' results: tally those instead
+      // (their dense samples are gone with the pipeline that made them: the scan poses stand in).
+      const std::vector<lio::ScanResult>& all = odometry->results();
+      ResetTally(&run);
+      for (size_t i = 0; i + 1 < all.size(); ++i) {
+        Tally(all[i], i, T_imu_lidar, &run);
+        if (all[i].status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
+          run.dense.push_back(run.trajectory.back());
+        }
+      }
+      run.warmup_replayed_scans = r.revised_scans;
+    }
+    Tally(r, done - 1, T_imu_lidar, &run);
+    if (r.status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
+      const SE3& T_rl = r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar;
+      auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
+      if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
+      for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_rl});
+    }
     if (options.progress) options.progress(done, total, r);
   }
   // The first scan (map creation) is not a registration: keep it out of the latency figures.
@@ -318,6 +367,8 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     // No ATE where there is no estimate to evaluate (e.g. every scan failed initialisation).
     const AteResult ate = EvaluateAte(run.trajectory, *truth);
     if (ate.pairs >= 3) run.ate = ate;
+    const AteResult live = EvaluateAte(run.live_trajectory, *truth);
+    if (live.pairs >= 3) run.live_ate = live;
     run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
     if (config.pose_covariance) PoseNees(run.scans, *truth, T_imu_lidar, &run);
   }

@@ -47,6 +47,12 @@ struct RunSummary {
   // SampleNewestInterval after every estimated scan), ending at each scan pose.
   std::vector<io::StampedPose> dense;
   std::vector<lio::ScanResult> scans;
+  // Calibration warm-up replay (calibration.warmup_replay_s): how many earlier scans it revised
+  // (0: none), and the trajectory as returned live, scan by scan, before the replay revised its
+  // start (the same as `trajectory` without a replay) with its ATE.
+  int warmup_replayed_scans = 0;
+  std::vector<io::StampedPose> live_trajectory;
+  std::optional<AteResult> live_ate;
   int failed = 0, degenerate = 0, imu_gaps = 0;
   // Scans whose lidar term had at least one degenerate direction (lio/degeneracy.h), whatever
   // their status (with an IMU they stay `ok`: the IMU and the prior carry those directions).

@@ -19,6 +19,11 @@ TEST(OdometryConfig, ShippedConfigsLoad) {
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
   EXPECT_EQ(sim.method, LioMethod::kSingerLio);
   EXPECT_TRUE(sim.exact_specific_force);
+  EXPECT_FALSE(sim.overlap_stages);  // one thread unless asked
+  EXPECT_TRUE(
+      LoadOdometryConfig(WriteTemp("overlap.yaml", "window:\n  overlap: true\n")).overlap_stages);
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp("overlap_bad.yaml", "window:\n  overlap: 2x\n")),
+               std::runtime_error);
   const OdometryConfig nc =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
   // SPEC §4: the paper's Newer College values where the file keeps them.
@@ -111,6 +116,23 @@ TEST(OdometryConfig, CalibrationSection) {
   EXPECT_THROW(LoadOdometryConfig(
                    WriteTemp("cal_h.yaml", "calibration:\n  observability_horizon_scans: -1\n")),
                std::runtime_error);
+  // The warm-up replay (lio_odometry.h): off by default, and only for an estimated calibration.
+  EXPECT_DOUBLE_EQ(o.calibration.warmup_replay_s, 0.0);
+  EXPECT_FALSE(c.calibration.replays_warmup());
+  const OdometryConfig w = LoadOdometryConfig(WriteTemp(
+      "cal_w.yaml", "calibration:\n  estimate_time_offset: true\n  warmup_replay_s: 2\n"));
+  EXPECT_TRUE(w.calibration.replays_warmup());
+  EXPECT_DOUBLE_EQ(w.calibration.warmup_replay_s, 2.0);
+  const OdometryConfig n =
+      LoadOdometryConfig(WriteTemp("cal_wn.yaml", "calibration:\n  warmup_replay_s: 2\n"));
+  EXPECT_FALSE(n.calibration.replays_warmup());  // nothing estimated: nothing to replay
+  for (const char* bad_span : {"-1", "61", ".nan"}) {
+    EXPECT_THROW(LoadOdometryConfig(WriteTemp("cal_wb.yaml", std::string("calibration:\n  "
+                                                                         "warmup_replay_s: ") +
+                                                                 bad_span + "\n")),
+                 std::runtime_error)
+        << bad_span;
+  }
   EXPECT_THROW(LoadOdometryConfig(WriteTemp(
                    "cal_t.yaml", "calibration:\n  rotation_observability_threshold: -1\n")),
                std::runtime_error);

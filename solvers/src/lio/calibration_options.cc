@@ -31,6 +31,9 @@ void CalibrationOptions::Validate() const {
   }
   require(std::isfinite(hold_information) && hold_information > 0,
           "calibration.hold_information must be positive");
+  // Beyond a minute the kept raw scans (≈ 7 MB per full-resolution 128-beam sweep) dominate.
+  require(std::isfinite(warmup_replay_s) && warmup_replay_s >= 0 && warmup_replay_s <= 60,
+          "calibration.warmup_replay_s must be in [0, 60] s (0: no replay)");
 }
 
 }  // namespace ctlio::lio

@@ -84,6 +84,7 @@ LioOdometry::LioOdometry(const OdometryConfig& config)
 LioOdometry::~LioOdometry() = default;
 
 std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double rate_hz) const {
+  if (replay_ != nullptr) return replay_->SampleNewestInterval(rate_hz);
   std::vector<std::pair<int64_t, SE3>> out;
   if (!initialised_ || rate_hz <= 0.0 || estimator_->num_states() < 2) return out;
   const int64_t origin = imu_.origin_ns();
@@ -102,18 +103,85 @@ std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double ra
 }
 
 bool LioOdometry::AddImu(const ImuSample& sample) {
+  if (replay_ != nullptr) return replay_->AddImu(sample);
   if (sample.imu >= config_.num_imus()) {
     throw std::invalid_argument("LioOdometry::AddImu: sample of IMU " + std::to_string(sample.imu) +
                                 ", the config declares " + std::to_string(config_.num_imus()) +
                                 " (imus:)");
   }
+  // Kept as given, rejected or not: the replay's own buffer applies the same gates again.
+  if (KeepsWarmup()) warmup_imu_.push_back(sample);
   return imu_.AddImu(sample);
 }
 
 ScanResult LioOdometry::AddScan(const LidarScan& input) {
+  if (replay_ != nullptr) return replay_->AddScan(input);
+  CheckScan(input);
+  if (KeepsWarmup()) warmup_scans_.emplace_back(input, warmup_imu_.size());
+  ScanResult result = RunScan(input);
+  if (KeepsWarmup()) MaybeReplayWarmup(&result);
+  return result;
+}
+
+void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
+  const double span = 1e-9 * static_cast<double>(warmup_scans_.back().first.end_ns -
+                                                 warmup_scans_.front().first.begin_ns);
+  const double needed = config_.calibration.warmup_replay_s;
+  if (span < needed) return;
+  warmup_done_ = true;
+  if (!initialised_ || result->status == ScanStatus::kFailed) {
+    if (span < 2.0 * needed) {
+      warmup_done_ = false;  // wait for an estimated scan
+      return;
+    }
+    AddNote(result, "calibration warm-up not replayed: no estimate after " + std::to_string(span) +
+                        " s (calibration.warmup_replay_s)");
+    warmup_scans_ = {};
+    warmup_imu_ = {};
+    return;
+  }
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMs();
-  CheckScan(input);
+  // The estimates after this scan become the replay's start values and prior means; the
+  // configured σ stays (the replay uses the same data again, so it must not also be told it
+  // is sure of them).
+  OdometryConfig replay_config = config_;
+  CalibrationOptions& cal = replay_config.calibration;
+  cal.warmup_replay_s = 0.0;
+  if (cal.estimate_time_offset && !result->calibration.time_offset_s.empty()) {
+    cal.time_offset_s = result->calibration.time_offset_s;
+  }
+  if (cal.estimate_extrinsic && result->calibration.has_extrinsic) {
+    replay_config.T_imu_lidar = result->calibration.T_imu_lidar;
+  }
+  auto replay = std::make_unique<LioOdometry>(replay_config);
+  size_t next_imu = 0;
+  ScanResult replayed;
+  for (const auto& [scan, imu_before] : warmup_scans_) {
+    for (; next_imu < imu_before; ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
+    replayed = replay->AddScan(scan);
+  }
+  for (; next_imu < warmup_imu_.size(); ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
+  // This call's cost is the live scan's and the whole replay's.
+  replayed.revised_scans = static_cast<int>(warmup_scans_.size()) - 1;
+  replayed.milliseconds = result->milliseconds + MsSince(start);
+  replayed.cpu_ms = result->cpu_ms + ThreadCpuMs() - cpu_start;
+  std::ostringstream note;
+  note << "calibration warm-up replayed: " << warmup_scans_.size() << " scans over " << span
+       << " s processed again from the estimates after this scan";
+  AddNote(&replayed, note.str());
+  replay->results_.back() = replayed;
+  warmup_results_ = std::move(results_);
+  results_ = {};
+  warmup_scans_ = {};
+  warmup_imu_ = {};
+  replay_ = std::move(replay);
+  *result = replayed;
+}
+
+ScanResult LioOdometry::RunScan(const LidarScan& input) {
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuMs();
   if (!have_origin_) {
     imu_.SetOrigin(input.begin_ns);
     have_origin_ = true;
@@ -123,11 +191,20 @@ ScanResult LioOdometry::AddScan(const LidarScan& input) {
   std::string dropped_note;  // added to the message once the scan is processed
   const LidarScan& scan = DropPointsOutsideInterval(input, &trimmed, &dropped_note);
   result.points_dropped = static_cast<int>(input.points.size() - scan.points.size());
-  const PreparedScan prepared = PrepareScan(scan);
+  const SE3 T_robot_lidar = CurrentExtrinsic();
+  std::future<std::pair<double, double>> overlapped = StartOverlappedStages();
+  const PreparedScan prepared = PrepareScan(scan, T_robot_lidar);
   result.ms_preprocess = MsSince(start);
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
   try {
+    // Joined before anything reads the map or the window; rethrows what the thread threw. The
+    // second thread's times go into this scan's map and marginalise columns.
+    if (overlapped.valid()) {
+      const auto [ms_map, ms_marginalize] = overlapped.get();
+      result.ms_map += ms_map;
+      result.ms_marginalize += ms_marginalize;
+    }
     if (!initialised_) {
       Initialise(prepared, &result);
     } else {
@@ -222,11 +299,17 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const auto t_map = std::chrono::steady_clock::now();
   if (EstimatePlausible(result)) {
-    frontend_.UpdateMap(estimator_->MapPoints(scan), estimator_->NewestPose().translation());
+    if (config_.overlap_stages) {  // inserted during the next scan's preprocessing
+      pending_map_points_ = estimator_->MapPoints(scan);
+      pending_map_position_ = estimator_->NewestPose().translation();
+      map_pending_ = true;
+    } else {
+      frontend_.UpdateMap(estimator_->MapPoints(scan), estimator_->NewestPose().translation());
+    }
   }
   if (registered.degenerate) ReportDegenerate(result);
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
-  result->ms_map = MsSince(t_map);
+  result->ms_map += MsSince(t_map);
   estimator_->Report(result);
   if (config_.pose_covariance) ReportPoseCovariance(result);
   if (config_.calibration.any()) {
@@ -368,13 +451,18 @@ void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
 }
 
 void LioOdometry::Slide(ScanResult* result) {
+  if (slid_) return;  // overlapped with the preprocessing (StartOverlappedStages)
+  result->ms_marginalize += SlideWindow();
+}
+
+double LioOdometry::SlideWindow() {
   const auto t0 = std::chrono::steady_clock::now();
   while (estimator_->num_states() > config_.window_knots - 1) {
     last_marginalization_ = window_.Marginalize(estimator_->OldestKeys());
     ++num_marginalizations_;
     estimator_->DropOldest();
   }
-  result->ms_marginalize += MsSince(t0);
+  return MsSince(t0);
 }
 
 void LioOdometry::CheckScan(const LidarScan& scan) const {
@@ -395,7 +483,30 @@ void LioOdometry::CheckScan(const LidarScan& scan) const {
   }
 }
 
-PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
+SE3 LioOdometry::CurrentExtrinsic() const {
+  return window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
+}
+
+std::future<std::pair<double, double>> LioOdometry::StartOverlappedStages() {
+  slid_ = false;
+  if (!config_.overlap_stages || (!map_pending_ && !initialised_)) return {};
+  // Process slides first thing (Initialise does not): done here beside the preprocessing, which
+  // reads neither the map nor the window (its extrinsic was read before).
+  const bool slide = initialised_;
+  slid_ = slide;
+  return std::async(std::launch::async, [this, slide] {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (map_pending_) {
+      frontend_.UpdateMap(pending_map_points_, pending_map_position_);
+      map_pending_ = false;
+      pending_map_points_.clear();
+    }
+    const double ms_map = MsSince(t0);
+    return std::make_pair(ms_map, slide ? SlideWindow() : 0.0);
+  });
+}
+
+PreparedScan LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar) {
   const double t_prev =
       initialised_ ? imu_.Seconds(last_scan_end_ns_) : imu_.Seconds(scan.begin_ns);
   PreparedScan prepared;
@@ -404,8 +515,7 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan) {
   prepared.end_ns = scan.end_ns;
   // The configured extrinsic, or with online calibration its current estimate (the lidar
   // residuals recover the lidar-frame points through prepared.T_robot_lidar).
-  prepared.T_robot_lidar =
-      window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
+  prepared.T_robot_lidar = T_robot_lidar;
   // Range gate and voxel subsampling in the lidar frame (one pass, no copy of the up to 230 000
   // raw returns of a 128-beam sweep), then on the survivors in the robot frame, and the
   // keypoints: one stream, no intermediate copies (LidarFrontend::SelectSweep).

@@ -202,6 +202,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
       ReadSection(v, section, source,
                   {{"knots", SetFromYaml(&c->window_knots)},
                    {"threads", SetFromYaml(&c->solver_threads)},
+                   {"overlap", SetFromYaml(&c->overlap_stages)},
                    {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
                    {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
     } else if (key == "extrinsic") {
@@ -238,7 +239,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"translation_observability_threshold",
             SetFromYaml(&o.translation_observability_threshold)},
            {"hold_unobservable", SetFromYaml(&o.hold_unobservable)},
-           {"hold_information", SetFromYaml(&o.hold_information)}});
+           {"hold_information", SetFromYaml(&o.hold_information)},
+           {"warmup_replay_s", SetFromYaml(&o.warmup_replay_s)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

@@ -15,6 +15,7 @@
 // The input gates (input_checks.h, thresholds in config.input) apply to every caller.
 #pragma once
 
+#include <future>
 #include <memory>
 #include <string>
 #include <utility>
@@ -48,25 +49,41 @@ class LioOdometry {
   // divergence, points outside the scan's interval, a frozen IMU) is reported in the result.
   ScanResult AddScan(const LidarScan& scan);
 
-  const OdometryConfig& config() const { return config_; }
-  const std::vector<ScanResult>& results() const { return results_; }
-  size_t duplicate_imu_samples() const { return imu_.duplicates(); }
-  size_t rejected_imu_samples() const { return imu_.rejected(); }
-  bool initialised() const { return initialised_; }
+  // After a warm-up replay (calibration.warmup_replay_s) everything below is the replayed
+  // pipeline's, which carries on: its config starts the calibration from the warm-up's estimates.
+  const OdometryConfig& config() const { return active().config_; }
+  const std::vector<ScanResult>& results() const { return active().results_; }
+  // The results returned live for the scans of the warm-up span, before the replay replaced
+  // them in results() (empty until a replay).
+  const std::vector<ScanResult>& warmup_results() const { return warmup_results_; }
+  size_t duplicate_imu_samples() const { return active().imu_.duplicates(); }
+  size_t rejected_imu_samples() const { return active().imu_.rejected(); }
+  bool initialised() const { return active().initialised_; }
   // Gravity-aligned frame i → map frame m (valid once initialised()).
-  const Mat3& C_mi() const { return C_mi_; }
+  const Mat3& C_mi() const { return active().C_mi_; }
   // The window the pipeline solves (SPEC §5): its states, residual blocks and marginal prior.
-  const SlidingWindow& window() const { return window_; }
-  SlidingWindow& window() { return window_; }
+  const SlidingWindow& window() const { return active().window_; }
+  SlidingWindow& window() { return replay_ != nullptr ? replay_->window_ : window_; }
   // What the most recent Schur-complement marginalisation did (empty before the first one).
-  const MarginalizationReport& last_marginalization() const { return last_marginalization_; }
-  int num_marginalizations() const { return num_marginalizations_; }
+  const MarginalizationReport& last_marginalization() const {
+    return active().last_marginalization_;
+  }
+  int num_marginalizations() const { return active().num_marginalizations_; }
   // The estimate T_mr sampled every 1/rate_hz s over the newest interval between states: the
   // grid times (multiples of the period in absolute ns) in (previous, newest state) and the newest
   // state's time, whose pose is the scan's T_mr. Empty before the second state.
   std::vector<std::pair<int64_t, SE3>> SampleNewestInterval(double rate_hz) const;
 
  private:
+  const LioOdometry& active() const { return replay_ != nullptr ? *replay_ : *this; }
+  // AddScan's work on a checked scan.
+  ScanResult RunScan(const LidarScan& input);
+  // Warm-up replay: true while the data is kept for it.
+  bool KeepsWarmup() const { return config_.calibration.replays_warmup() && !warmup_done_; }
+  // After `result`'s scan: once the kept data spans warmup_replay_s and the scan was estimated,
+  // processes it again in replay_ from the estimates in `result` and replaces `result` with the
+  // replay's; gives up (note, data dropped) if twice the span passes without an estimate.
+  void MaybeReplayWarmup(ScanResult* result);
   void CheckScan(const LidarScan& scan) const;
   // Input gate: the points timed outside [interval start − tolerance, end + tolerance]
   // (config.input.scan_time_tolerance; the interval starts at the previous scan's end once
@@ -74,9 +91,16 @@ class LioOdometry {
   // when none is.
   const LidarScan& DropPointsOutsideInterval(const LidarScan& scan, LidarScan* trimmed,
                                              std::string* note) const;
-  // Robot-frame points (extrinsic), range gate, voxel subsampling, keypoints, time order. Times
-  // within the tolerance outside the interval (driver clock jitter) are clamped onto it.
-  PreparedScan PrepareScan(const LidarScan& scan);
+  // Robot-frame points (T_robot_lidar: the extrinsic or its estimate), range gate, voxel
+  // subsampling, keypoints, time order. Times within the tolerance outside the interval (driver
+  // clock jitter) are clamped onto it.
+  PreparedScan PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar);
+  // The extrinsic the next scan is prepared with: its online estimate, or the configured one.
+  SE3 CurrentExtrinsic() const;
+  // config.overlap_stages: the previous scan's map insertion and, before a registration, the
+  // marginalisation, on a second thread; returns their wall ms (map, marginalise), or no future
+  // without the overlap.
+  std::future<std::pair<double, double>> StartOverlappedStages();
   // First scan: gravity initialisation (with an IMU), the first state, the map.
   void Initialise(const PreparedScan& scan, ScanResult* result);
   // Every later scan.
@@ -84,6 +108,8 @@ class LioOdometry {
   // Schur-complement marginalisation of the oldest states until window_knots − 1 remain, before
   // the new state is added (SPEC §5): their information is kept in one prior, not dropped.
   void Slide(ScanResult* result);
+  // The marginalisation of Slide; its wall ms.
+  double SlideWindow();
   // A scan is gapped if the IMU(s) the estimator uses all have a hole above init.max_imu_gap
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
@@ -141,6 +167,20 @@ class LioOdometry {
   std::vector<StateId> calibration_states_;
   std::vector<ceres::ResidualBlockId> holds_;
   int num_marginalizations_ = 0;
+  // config.overlap_stages: the map insertion left for the next scan, and whether this scan's
+  // marginalisation is done (overlapped with its preprocessing).
+  std::vector<Vec3> pending_map_points_;
+  Vec3 pending_map_position_ = Vec3::Zero();
+  bool map_pending_ = false;
+  bool slid_ = false;
+  // Warm-up replay (calibration.warmup_replay_s): every IMU sample and scan of the span as given
+  // (each scan with the number of samples added before it), the pipeline that replayed them
+  // (every call is forwarded to it from then on), and the live results it replaced.
+  std::vector<ImuSample> warmup_imu_;
+  std::vector<std::pair<LidarScan, size_t>> warmup_scans_;
+  std::unique_ptr<LioOdometry> replay_;
+  std::vector<ScanResult> warmup_results_;
+  bool warmup_done_ = false;
 };
 
 // The pipeline of config.method.

@@ -96,6 +96,11 @@ struct OdometryConfig {
   // --- Window and solver.
   int window_knots = 2;    // newest knots kept free (SPEC §4: 2, the one before held)
   int solver_threads = 1;  // Ceres threads (iterations per round: lidar_frontend.solver_iterations)
+  // window.overlap: scan k's voxel-map insertion and the marginalisation before scan k+1 run on a
+  // second thread while scan k+1 is range-gated and subsampled (neither reads what the other
+  // writes), instead of one after the other on the scan thread. The same estimates, bit for bit;
+  // AddScan returns once scan k's pose is estimated, its map insertion runs during the next call.
+  bool overlap_stages = false;
   bool estimate_gravity = false;  // hold C_mi after initialisation (paper) or refine it
 
   // --- Sensor setup.
@@ -206,6 +211,10 @@ struct ScanResult {
   // CPU time of this scan's thread (CLOCK_THREAD_CPUTIME_ID): unlike the wall times above it
   // does not grow when other processes share the cores.
   double cpu_ms = 0.0;
+  // Earlier scans whose results this scan replaced (calibration.warmup_replay_s): that many
+  // entries before this one in LioOdometry::results() now hold the replayed estimates; a
+  // caller that kept the earlier results re-reads them. 0 for every other scan.
+  int revised_scans = 0;
   // Online calibration (OdometryConfig::calibration) after this scan: the estimates and their
   // marginal σ (ceres::Covariance of the window). Empty / false when not estimated.
   struct CalibrationEstimate {
