@@ -69,6 +69,8 @@ DEFINE_int32(first_sequence, 0, "Index of the first sequence");
 DEFINE_double(duration, 20.0, "Sequence length [s] (the paper: 20)");
 DEFINE_int32(beams, 128, "Lidar beams (the paper: 128)");
 DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resolution)");
+DEFINE_double(lidar_rate, 10.0,
+              "Lidar revolutions (= scans, = knots) per second (the firings per revolution stay)");
 DEFINE_int32(threads, 0, "Parallel runs (0 = number of cores)");
 DEFINE_bool(body_centric, false, "Simulate the paper's body-centric accelerometer model");
 DEFINE_double(failure_ate, 1.0, "A run whose ATE exceeds this [m] counts as a failure");
@@ -236,6 +238,7 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
   // Only when set, so that single-IMU settings (and merges with earlier jobs) stay as they were.
   if (!FLAGS_imus.empty()) s << "imus " << FLAGS_imus << "\n";
   if (!FLAGS_extrinsic_error.empty()) s << "extrinsic_error " << FLAGS_extrinsic_error << "\n";
+  if (shared.lidar.rate_hz != 10.0) s << "lidar_rate_hz " << shared.lidar.rate_hz << "\n";
   return s.str();
 }
 
@@ -492,6 +495,7 @@ int main(int argc, char** argv) {
     given.duration_s = Given("duration", FLAGS_duration);
     given.beams = Given("beams", FLAGS_beams);
     given.firing_decimation = Given("firing_decimation", FLAGS_firing_decimation);
+    given.lidar_rate_hz = Given("lidar_rate", FLAGS_lidar_rate);
     given.body_centric = Given("body_centric", FLAGS_body_centric);
     const std::string world_name = sim::WorldName(given.world.value_or(sim::PresetWorld(preset)));
     const auto regimes =

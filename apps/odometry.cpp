@@ -97,6 +97,9 @@ DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | 
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
 DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
+DEFINE_double(sim_lidar_rate, 10.0,
+              "--format sim: lidar revolutions (= scans, = knots) per second; the firings per "
+              "revolution stay, so a faster rate spreads them over a shorter sweep");
 DEFINE_int32(sim_beams, 128, "--format sim: lidar beams");
 DEFINE_string(sim_imus, "",
               "--format sim: further IMUs, ';'-separated key=value lists (rate, xyz, rpy, offset, "
@@ -143,6 +146,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     given.duration_s = Given("sim_duration", FLAGS_sim_duration);
     given.firing_decimation = Given("sim_firing_decimation", FLAGS_sim_firing_decimation);
     given.beams = Given("sim_beams", FLAGS_sim_beams);
+    given.lidar_rate_hz = Given("sim_lidar_rate", FLAGS_sim_lidar_rate);
     sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
     c.imu.stamp_offset_s = FLAGS_sim_imu_stamp_offset;

@@ -11,6 +11,7 @@
 
 #include "common/temp_dir.h"
 #include "ctlio/io/newer_college.h"
+#include "ctlio/sim/lidar_inertial_sim.h"
 
 namespace ctlio::sim {
 namespace {
@@ -84,6 +85,30 @@ TEST(Presets, ExplicitSettingsOverrideThePreset) {
   EXPECT_EQ(c.lidar.firings_per_revolution, 1024);
   EXPECT_DOUBLE_EQ(c.imu.rate_hz, 100.0);
   EXPECT_GT(c.imu.gyro_bias_walk, 0.0);
+  EXPECT_DOUBLE_EQ(c.lidar.rate_hz, 10.0);
+}
+
+TEST(Presets, LidarRateSetsTheScanRate) {
+  SimOverrides o;
+  o.lidar_rate_hz = 20.0;
+  o.duration_s = 1.0;
+  o.beams = 4;
+  o.firing_decimation = 16;
+  const SimConfig c = PresetConfig(Preset::kNone, 0, kExperimentSeed, o);
+  EXPECT_DOUBLE_EQ(c.lidar.rate_hz, 20.0);
+  // Twice the scans of a 10 Hz sensor, each half as long.
+  SimulatedSource source(c);
+  io::ScanFrame frame;
+  int scans = 0;
+  while (source.Next(&frame)) {
+    ++scans;
+    EXPECT_NEAR(1e-9 * static_cast<double>(frame.end_ns - frame.start_ns), 0.05, 0.005);
+  }
+  EXPECT_EQ(scans, 20);
+  for (const double bad : {0.0, -5.0, 101.0}) {
+    o.lidar_rate_hz = bad;
+    EXPECT_THROW(PresetConfig(Preset::kNone, 0, kExperimentSeed, o), std::runtime_error) << bad;
+  }
 }
 
 TEST(Presets, NewerCollegeLayoutReadsBackWithThePublishedExtrinsic) {

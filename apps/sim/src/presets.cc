@@ -56,6 +56,13 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrid
   if (o.duration_s) c.duration_s = *o.duration_s;
   if (o.beams) c.lidar.beams = *o.beams;
   if (o.firing_decimation) c.lidar.firing_decimation = *o.firing_decimation;
+  if (o.lidar_rate_hz) {
+    if (!(*o.lidar_rate_hz > 0.0 && *o.lidar_rate_hz <= 100.0)) {
+      throw std::runtime_error("lidar rate " + std::to_string(*o.lidar_rate_hz) +
+                               " Hz: must be in (0, 100]");
+    }
+    c.lidar.rate_hz = *o.lidar_rate_hz;
+  }
   if (o.range_noise_per_m) c.lidar.range_noise_per_m = *o.range_noise_per_m;
   if (o.body_centric) c.imu.body_centric = *o.body_centric;
   if (o.accel_bias_walk) c.imu.accel_bias_walk = *o.accel_bias_walk;

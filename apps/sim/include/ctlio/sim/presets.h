@@ -34,6 +34,7 @@ struct SimOverrides {
   std::optional<double> duration_s;
   std::optional<int> beams;
   std::optional<int> firing_decimation;
+  std::optional<double> lidar_rate_hz;  // revolutions (scans) per second, in (0, 100]
   std::optional<double> range_noise_per_m;
   std::optional<bool> body_centric;
   std::optional<double> accel_bias_walk;  // m/s²/√s
