@@ -3,7 +3,10 @@
 // off the truth, the estimate moves towards the truth and its marginal σ shrinks from the prior's;
 // the extrinsic is a static state that stays in the window (kept by the marginal prior) and is
 // read by every lidar residual. Off, no extrinsic state exists.
+#include <ceres/covariance.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -81,6 +84,42 @@ TEST(ExtrinsicCalibration, ConvergesFromAWrongStartAndSigmaShrinks) {
   EXPECT_NE(std::find(kept.begin(), kept.end(), kExtrinsicKey), kept.end());
   EXPECT_GE(static_cast<int>(odometry->window().ResidualBlocksOf(kExtrinsicKey).size()),
             last.associations);
+}
+
+// The reported marginal σ of the calibration states (the Schur complement of the whole window's
+// information onto them, LioOdometry::ReportCalibrationCovariance) is the window's pseudo-inverse
+// as Ceres computes it (ceres::Covariance, dense SVD of the Jacobian, null space dropped: C_mi
+// is refined with the extrinsic and its yaw about gravity is free), with both calibrations.
+TEST(ExtrinsicCalibration, ReportedSigmaIsTheWindowsPseudoInverse) {
+  sim::SimConfig c = Sequence(1.0);
+  c.imu.stamp_offset_s = 0.02;
+  OdometryConfig config = Config(true);
+  config.calibration.estimate_time_offset = true;
+  std::vector<ScanResult> results;
+  const auto odometry = RunSequence(c, config, &results);
+  const ScanResult& last = results.back();
+  ASSERT_NE(last.status, ScanStatus::kFailed) << last.message;
+  ASSERT_EQ(last.calibration.time_offset_sigma_s.size(), 1u);
+  SlidingWindow& window = odometry->window();
+  const double* offset = window.State(TimeOffsetKey(0));
+  const double* extrinsic = window.State(kExtrinsicKey);
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.null_space_rank = -1;
+  ceres::Covariance covariance(options);
+  ASSERT_TRUE(covariance.Compute({{offset, offset}, {extrinsic, extrinsic}}, &window.problem()));
+  double var = 0.0;
+  ASSERT_TRUE(covariance.GetCovarianceBlockInTangentSpace(offset, offset, &var));
+  EXPECT_NEAR(last.calibration.time_offset_sigma_s[0], std::sqrt(var), 1e-6 * std::sqrt(var));
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
+  ASSERT_TRUE(covariance.GetCovarianceBlockInTangentSpace(extrinsic, extrinsic, block.data()));
+  const Vec6 reference = block.diagonal().cwiseSqrt();
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(last.calibration.extrinsic_sigma[i], reference[i], 1e-6 * reference[i]) << i;
+  }
+  // And well below the priors' (30 ms; 0.2 m, 5°): the measurements are in it.
+  EXPECT_LT(last.calibration.time_offset_sigma_s[0], 0.003);
+  EXPECT_LT(last.calibration.extrinsic_sigma.tail<3>().maxCoeff(), 2.0 * M_PI / 180.0);
 }
 
 TEST(ExtrinsicCalibration, OffThereIsNoExtrinsicState) {

@@ -2,6 +2,7 @@
 
 #include <ceres/covariance.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -410,43 +411,42 @@ void LioOdometry::ReportPoseCovariance(ScanResult* result) {
 }
 
 void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
-  // The calibration states in the window (the estimators that have them), all in one
-  // ceres::Covariance: the clock offsets (1-D each) and the extrinsic T_imu_lidar (pose block).
-  std::vector<const double*> offsets;
+  // The calibration states in the window (the estimators that have them): the clock offsets
+  // (1-D each), then the extrinsic T_imu_lidar (pose block, PoseManifold's left [ρ; φ]).
+  std::vector<StateId> states;
+  int offsets = 0;
   for (int j = 0; j < config_.num_imus(); ++j) {
-    if (window_.HasState(TimeOffsetKey(j))) offsets.push_back(window_.State(TimeOffsetKey(j)));
+    if (!window_.HasState(TimeOffsetKey(j))) continue;
+    states.push_back(TimeOffsetKey(j));
+    ++offsets;
   }
-  const double* extrinsic = result->calibration.has_extrinsic && window_.HasState(kExtrinsicKey)
-                                ? window_.State(kExtrinsicKey)
-                                : nullptr;
-  if (offsets.empty() && extrinsic == nullptr) return;
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (const double* x : offsets) blocks.emplace_back(x, x);
-  if (extrinsic != nullptr) blocks.emplace_back(extrinsic, extrinsic);
-  ceres::Covariance::Options options;
-  if (extrinsic != nullptr) {
-    // Dense SVD (the window has < 100 tangent parameters) with the null space dropped: C_mi,
-    // refined with the extrinsic, has a null direction (the yaw about gravity), which the default
-    // sparse QR refuses; the pseudo-inverse gives the calibration's marginal σ.
-    options.algorithm_type = ceres::DENSE_SVD;
-    options.null_space_rank = -1;
+  const bool extrinsic = result->calibration.has_extrinsic && window_.HasState(kExtrinsicKey);
+  if (extrinsic) states.push_back(kExtrinsicKey);
+  if (states.empty()) return;
+  // Their marginal covariance is the inverse of their marginal information: every residual of
+  // the window linearised once, every other state marginalised by the Schur complement
+  // (degeneracy.h, as for the observability check). Its pseudo-inverse drops the null direction
+  // that C_mi has when it is refined with the extrinsic (the yaw about gravity): the value of
+  // the window's pseudo-inverse (ceres::Covariance, dense SVD, null space dropped, which the
+  // test compares with) at a quarter of the instructions, since that SVD is of the whole
+  // ~1000-row Jacobian.
+  std::vector<ceres::ResidualBlockId> residuals;
+  window_.problem().GetResidualBlocks(&residuals);
+  const Eigen::MatrixXd information = MarginalInformation(window_, residuals, states);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(information);
+  const bool ok = eig.info() == Eigen::Success && eig.eigenvalues().minCoeff() > 0.0;
+  Eigen::MatrixXd covariance;
+  if (ok) {
+    covariance = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
+                 eig.eigenvectors().transpose();
   }
-  // Otherwise sparse QR: a rank-deficient window gives no σ (NaN) rather than a pseudo-inverse.
-  ceres::Covariance covariance(options);
-  const bool ok = covariance.Compute(blocks, &window_.problem());
   auto& cal = result->calibration;
   cal.time_offset_sigma_s.clear();
-  for (const double* x : offsets) {
-    double var = std::nan("");
-    if (ok) covariance.GetCovarianceBlockInTangentSpace(x, x, &var);
-    cal.time_offset_sigma_s.push_back(var >= 0.0 ? std::sqrt(var) : std::nan(""));
+  for (int j = 0; j < offsets; ++j) {
+    cal.time_offset_sigma_s.push_back(ok ? std::sqrt(covariance(j, j)) : std::nan(""));
   }
-  if (extrinsic != nullptr && ok) {
-    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
-    if (covariance.GetCovarianceBlockInTangentSpace(extrinsic, extrinsic, block.data())) {
-      // PoseManifold's left perturbation [ρ; φ] of T_rl.
-      cal.extrinsic_sigma = block.diagonal().cwiseMax(0.0).cwiseSqrt();
-    }
+  if (extrinsic && ok) {
+    cal.extrinsic_sigma = covariance.diagonal().tail<6>().cwiseMax(0.0).cwiseSqrt();
   }
 }
 
