@@ -116,8 +116,9 @@ class LioOdometry {
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   void ReportPoseCovariance(ScanResult* result);
-  // With online calibration: the marginal σ of the calibration states (clock offsets, extrinsic;
-  // one ceres::Covariance of the window, as ReportPoseCovariance) into result->calibration.
+  // With online calibration: the marginal σ of the calibration states (clock offsets, extrinsic)
+  // into result->calibration: the inverse of their marginal information in the whole window
+  // (MarginalInformation), the window's pseudo-inverse; NaN when that is not positive definite.
   void ReportCalibrationCovariance(ScanResult* result);
   // With online calibration and calibration.observability_horizon_scans > 0: the newest
   // interval's information on the calibration coordinates into the horizon

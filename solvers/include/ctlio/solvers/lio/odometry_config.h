@@ -216,7 +216,7 @@ struct ScanResult {
   // caller that kept the earlier results re-reads them. 0 for every other scan.
   int revised_scans = 0;
   // Online calibration (OdometryConfig::calibration) after this scan: the estimates and their
-  // marginal σ (ceres::Covariance of the window). Empty / false when not estimated.
+  // marginal σ (the window's pseudo-inverse). Empty / false when not estimated.
   struct CalibrationEstimate {
     std::vector<double> time_offset_s;        // δ_j per IMU [s]
     std::vector<double> time_offset_sigma_s;  // marginal σ of δ_j [s]
