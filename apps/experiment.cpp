@@ -460,11 +460,9 @@ void WriteObservability(const std::string& out, const std::vector<Job>& jobs) {
     const std::vector<double> fraction = lioapp::UnobservableFraction(j.run);
     const auto& c = last->calibration;
     for (size_t i = 0; i < names.size(); ++i) {
-      const bool assessed = i < c.observability.size() && i < c.unobservable.size();
-      csv << j.regime << ',' << j.index << ',' << j.method << ',' << names[i] << ','
-          << (assessed ? c.observability[i] : NAN) << ','
-          << (assessed ? (c.unobservable[i] ? "unobservable" : "observable") : "-") << ','
-          << (i < fraction.size() ? fraction[i] : NAN) << "\n";
+      csv << j.regime << ',' << j.index << ',' << j.method << ',' << names[i] << ',';
+      lioapp::WriteCoordinateObservability(c, i, csv);
+      csv << ',' << (i < fraction.size() ? fraction[i] : NAN) << "\n";
     }
   }
   if (any) io::WriteTextFile(out + "/observability.csv", csv.str());

@@ -28,6 +28,15 @@ std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::Calibrati
   return names;
 }
 
+void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c, size_t i,
+                                  std::ostream& out) {
+  if (i < c.observability.size() && i < c.unobservable.size()) {
+    out << c.observability[i] << ',' << (c.unobservable[i] ? "unobservable" : "observable");
+  } else {
+    out << "nan,-";
+  }
+}
+
 void WriteObservabilitySummary(const RunSummary& run, std::ostream& out) {
   const lio::ScanResult* last = LastCalibration(run);
   if (last == nullptr || !HasObservability(run)) return;
@@ -122,12 +131,8 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
     if (observability) {
       // Not assessed (the initialising scan): NaN and "-".
       for (size_t i = 0; i < coordinates.size(); ++i) {
-        if (i < c.observability.size() && i < c.unobservable.size()) {
-          f << ',' << c.observability[i] << ','
-            << (c.unobservable[i] ? "unobservable" : "observable");
-        } else {
-          f << ",nan,-";
-        }
+        f << ',';
+        WriteCoordinateObservability(c, i, f);
       }
     }
     f << "\n";

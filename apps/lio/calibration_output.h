@@ -19,6 +19,10 @@ const lio::ScanResult* LastCalibration(const RunSummary& run);
 // Names of the calibration coordinates of an estimate, in the order of its observability:
 // time_offset_<j> per IMU, then extrinsic_rho_<x|y|z>, extrinsic_phi_<x|y|z>.
 std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::CalibrationEstimate& c);
+// Coordinate i's observability after a scan as two CSV fields, "ν,observable|unobservable", or
+// "nan,-" where it was not assessed (the initialising scan, the check off).
+void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c, size_t i,
+                                  std::ostream& out);
 // Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
 // unobservable after the last scan, or -), calibration_information_final (ν per coordinate) and
 // calibration_unobservable_fraction (per coordinate, of the assessed scans). Nothing without the

@@ -329,26 +329,28 @@ void LioOdometry::AssessCalibrationObservability(ScanResult* result) {
       if (seen.insert(r).second) newest.push_back(r);
     }
   }
-  observability_->AddScan(MarginalInformation(window_, newest, calibration_states_));
+  observability_->AddScan(MarginalInformation(window_, newest, CalibrationStates()));
   const Eigen::VectorXd& nu = observability_->whitened_information();
   result->calibration.observability.assign(nu.data(), nu.data() + nu.size());
   result->calibration.unobservable = observability_->Unobservable();
 }
 
+std::vector<StateId> LioOdometry::CalibrationStates() const {
+  std::vector<StateId> states;
+  for (int j = 0; j < config_.num_imus(); ++j) {
+    if (window_.HasState(TimeOffsetKey(j))) states.push_back(TimeOffsetKey(j));
+  }
+  if (window_.HasState(kExtrinsicKey)) states.push_back(kExtrinsicKey);
+  return states;
+}
+
 bool LioOdometry::StartObservability() {
   if (observability_ != nullptr) return true;
   if (config_.calibration.observability_horizon_scans == 0) return false;
-  // The calibration states the estimator keeps (the baseline has none), in the order of the
-  // coordinates: the clock offsets, then the extrinsic.
-  int offsets = 0;
-  for (int j = 0; j < config_.num_imus(); ++j) {
-    if (!window_.HasState(TimeOffsetKey(j))) continue;
-    calibration_states_.push_back(TimeOffsetKey(j));
-    ++offsets;
-  }
-  const bool extrinsic = window_.HasState(kExtrinsicKey);
-  if (extrinsic) calibration_states_.push_back(kExtrinsicKey);
-  if (calibration_states_.empty()) return false;
+  const std::vector<StateId> states = CalibrationStates();
+  if (states.empty()) return false;
+  const bool extrinsic = states.back() == kExtrinsicKey;
+  const int offsets = static_cast<int>(states.size()) - (extrinsic ? 1 : 0);
   observability_ =
       std::make_unique<CalibrationObservability>(config_.calibration, offsets, extrinsic);
   return true;
@@ -367,7 +369,7 @@ void LioOdometry::HoldUnobservableCalibration(ScanResult* result) {
   const double w = std::sqrt(config_.calibration.hold_information);
   const Eigen::VectorXd& sigma = observability_->prior_sigma();
   int i = 0;
-  for (const StateId id : calibration_states_) {
+  for (const StateId id : CalibrationStates()) {
     if (id == kExtrinsicKey) {
       Mat6 sqrt_information = Mat6::Zero();
       for (int a = 0; a < 6; ++a, ++i) {
@@ -411,18 +413,11 @@ void LioOdometry::ReportPoseCovariance(ScanResult* result) {
 }
 
 void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
-  // The calibration states in the window (the estimators that have them): the clock offsets
-  // (1-D each), then the extrinsic T_imu_lidar (pose block, PoseManifold's left [ρ; φ]).
-  std::vector<StateId> states;
-  int offsets = 0;
-  for (int j = 0; j < config_.num_imus(); ++j) {
-    if (!window_.HasState(TimeOffsetKey(j))) continue;
-    states.push_back(TimeOffsetKey(j));
-    ++offsets;
-  }
-  const bool extrinsic = result->calibration.has_extrinsic && window_.HasState(kExtrinsicKey);
-  if (extrinsic) states.push_back(kExtrinsicKey);
+  // The extrinsic's tangent is PoseManifold's left [ρ; φ].
+  const std::vector<StateId> states = CalibrationStates();
   if (states.empty()) return;
+  const bool extrinsic = states.back() == kExtrinsicKey;
+  const int offsets = static_cast<int>(states.size()) - (extrinsic ? 1 : 0);
   // Their marginal covariance is the inverse of their marginal information: every residual of
   // the window linearised once, every other state marginalised by the Schur complement
   // (degeneracy.h, as for the observability check). Its pseudo-inverse drops the null direction

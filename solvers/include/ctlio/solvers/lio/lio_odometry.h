@@ -129,6 +129,9 @@ class LioOdometry {
   // move it; ReleaseCalibration removes them after the solve.
   void HoldUnobservableCalibration(ScanResult* result);
   void ReleaseCalibration();
+  // The calibration states the estimator keeps in the window (the baseline has none), in the
+  // order of the coordinates: the clock offsets (1-D each), then the extrinsic T_imu_lidar.
+  std::vector<StateId> CalibrationStates() const;
   // Creates observability_ over the calibration states in the window; false when there are none
   // or the check is off.
   bool StartObservability();
@@ -162,10 +165,9 @@ class LioOdometry {
   bool initialised_ = false;
   std::vector<ScanResult> results_;
   MarginalizationReport last_marginalization_;
-  // Online calibration's observability (created at the first assessment) over the states
-  // calibration_states_ (clock offsets, then the extrinsic), and the hold priors of this scan.
+  // Online calibration's observability (created at the first assessment) over the states of
+  // CalibrationStates(), and the hold priors of this scan.
   std::unique_ptr<CalibrationObservability> observability_;
-  std::vector<StateId> calibration_states_;
   std::vector<ceres::ResidualBlockId> holds_;
   int num_marginalizations_ = 0;
   // config.overlap_stages: the map insertion left for the next scan, and whether this scan's
