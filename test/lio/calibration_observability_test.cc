@@ -10,7 +10,7 @@
 
 #include <cmath>
 
-#include "ctlio/sim/extrinsic_error.h"
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -90,14 +90,8 @@ TEST(CalibrationObservability, RejectsAMatrixOfTheWrongSize) {
 // Both calibrations from the wrong start (20 ms clock offset; 3° / 10 cm extrinsic) on sequence
 // `regime`/100 for `duration_s`, the observability check at its defaults.
 lioapp::RunSummary RunBoth(sim::Regime regime, double duration_s) {
-  sim::SimConfig c = sim::ExperimentConfig(regime, 100);
-  c.duration_s = duration_s;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 4;
-  c.imu.stamp_offset_s = 0.020;
-  c.nominal_imu_from_lidar = sim::NominalExtrinsic(
-      c.imu_from_lidar, sim::ParseExtrinsicError("3deg,0.10m"), sim::kExperimentSeed, 100);
-  OdometryConfig config = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const sim::SimConfig c = testing::WrongCalibrationSequence(regime, duration_s, 0.020);
+  OdometryConfig config = testing::SimLioConfig();
   config.calibration.estimate_time_offset = true;
   config.calibration.estimate_extrinsic = true;
   config.calibration.hold_unobservable = true;  // off by default; the slow test checks the hold

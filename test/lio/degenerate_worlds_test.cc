@@ -12,6 +12,7 @@
 #include <cmath>
 #include <vector>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -28,7 +29,7 @@ sim::SimConfig Walk(sim::WorldKind world) {
 }
 
 OdometryConfig Config(LioMethod method) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   return c.ForMethod(method);
 }
 

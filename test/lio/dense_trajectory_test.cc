@@ -3,6 +3,7 @@
 // the scan pose, and follows the truth between the scans as closely as the scan poses do.
 #include <gtest/gtest.h>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
@@ -16,8 +17,7 @@ TEST(DenseTrajectory, EndsAtTheScanPosesAndFollowsTheTruth) {
   c.lidar.beams = 16;
   c.lidar.firing_decimation = 8;
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
-    OdometryConfig config =
-        LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+    OdometryConfig config = testing::SimLioConfig();
     config.method = m;
     sim::SimulatedSource source(c);
     lioapp::RunOptions options;

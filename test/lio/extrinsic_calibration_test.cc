@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -16,18 +17,13 @@
 namespace ctlio::lio {
 namespace {
 
+// The clock right: the extrinsic alone starts wrong.
 sim::SimConfig Sequence(double duration_s) {
-  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 100);
-  c.duration_s = duration_s;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 4;
-  c.nominal_imu_from_lidar = sim::NominalExtrinsic(
-      c.imu_from_lidar, sim::ParseExtrinsicError("3deg,0.10m"), sim::kExperimentSeed, 100);
-  return c;
+  return testing::WrongCalibrationSequence(sim::Regime::kMedium, duration_s, 0.0);
 }
 
 OdometryConfig Config(bool estimate) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   c.calibration.estimate_extrinsic = estimate;
   return c;
 }

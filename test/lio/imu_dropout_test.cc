@@ -5,6 +5,7 @@
 // by the outage is flagged imu_gap, none fails, and the ATE stays bounded (fixed simulator seed).
 #include <gtest/gtest.h>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -24,7 +25,7 @@ sim::SimConfig SequenceWithOutage() {
 }
 
 OdometryConfig Config(LioMethod method) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   c.method = method;
   return c;
 }

@@ -9,6 +9,7 @@
 
 #include <functional>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -119,9 +120,7 @@ sim::SimConfig Tiny(double duration_s = 1.0) {
   return c;
 }
 
-OdometryConfig Config() {
-  return LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
-}
+OdometryConfig Config() { return testing::SimLioConfig(); }
 
 // The simulator (Tiny, `duration_s`) fed straight into LioOdometry (no runner), with the IMU
 // samples and the scans edited on the way; edit_scan gets the scan's index and the previous

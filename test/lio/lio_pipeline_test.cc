@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -22,7 +23,7 @@ sim::SimConfig ShortSequence() {
 }
 
 OdometryConfig Config(LioMethod method) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   c.method = method;
   return c;
 }

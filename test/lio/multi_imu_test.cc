@@ -5,6 +5,7 @@
 // a sample of an undeclared IMU is an error; a scan is gapped only if every IMU is.
 #include <gtest/gtest.h>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -27,7 +28,7 @@ sim::SimConfig TwoImuSequence(double duration_s, const std::string& outage = "")
 }
 
 OdometryConfig Config(LioMethod method) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   c.method = method;
   return c;
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "common/sim_lio.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -27,7 +28,7 @@ sim::SimConfig Sequence(double duration_s, double stamp_offset_s, const std::str
 }
 
 OdometryConfig Config(LioMethod method, bool estimate) {
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig c = testing::SimLioConfig();
   c.method = method;
   c.calibration.estimate_time_offset = estimate;
   return c;

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "ctlio/sim/extrinsic_error.h"
+#include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "lio/run_odometry.h"
@@ -15,18 +15,11 @@ namespace ctlio::lio {
 namespace {
 
 sim::SimConfig WrongStart(double duration_s) {
-  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 100);
-  c.duration_s = duration_s;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 4;
-  c.imu.stamp_offset_s = 0.020;
-  c.nominal_imu_from_lidar = sim::NominalExtrinsic(
-      c.imu_from_lidar, sim::ParseExtrinsicError("3deg,0.10m"), sim::kExperimentSeed, 100);
-  return c;
+  return testing::WrongCalibrationSequence(sim::Regime::kMedium, duration_s, 0.020);
 }
 
 OdometryConfig Calibrating(double warmup_replay_s) {
-  OdometryConfig config = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  OdometryConfig config = testing::SimLioConfig();
   config.calibration.estimate_time_offset = true;
   config.calibration.estimate_extrinsic = true;
   config.calibration.warmup_replay_s = warmup_replay_s;
