@@ -391,6 +391,10 @@ int main(int argc, char** argv) {
       }
       if (config.calibration.any()) {
         lioapp::WriteCalibrationLog(out + "/calibration.csv", run);
+        // After a warm-up replay, the estimates it replaced, which the plot draws beside it.
+        if (!run.warmup_live_scans.empty()) {
+          lioapp::WriteCalibrationLog(out + "/calibration_live.csv", run, &run.warmup_live_scans);
+        }
         lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run);
         if (const lio::ScanResult* last = lioapp::LastCalibration(run)) {
           const auto& c = last->calibration;

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Plots the odometry's online calibration over time (calibration.csv of ctlio_odometry --out):
 each estimate with its ±3σ band, the truth when calibration.yaml states one (simulator), and in
-grey the spans the observability check reported the coordinate unobservable.
+grey the spans the observability check reported the coordinate unobservable. After a warm-up
+replay (calibration.warmup_replay_s) calibration.csv holds the replayed estimates, which start
+from the values reached at the replay; calibration_live.csv, the estimates returned live before
+it, is drawn as a dashed line up to a vertical line at the replay.
 
 Usage: plot_calibration.py FOLDER [FOLDER ...]   (writes FOLDER/calibration.png)
 """
@@ -109,6 +112,9 @@ def plot(folder):
                            key, f"extrinsic_phi_{a}_status"))
     if not series:
         return
+    live_path = os.path.join(folder, "calibration_live.csv")
+    live = read_columns(live_path) if os.path.exists(live_path) else {}
+    t_live = [x - t0 for x in live.get("t_s", [])]
     truth = read_truth(folder)
     truth.update(read_extrinsic_truth(folder))
     fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
@@ -119,6 +125,10 @@ def plot(folder):
         lo = [e - 3 * s for e, s in zip(est, sig)]
         hi = [e + 3 * s for e, s in zip(est, sig)]
         ax.fill_between(t, lo, hi, color="tab:red", alpha=0.2, label="±3σ")
+        if t_live and key in live:
+            ax.plot(t_live, [scale * v for v in live[key]], color="tab:blue", linestyle="--",
+                    label="live, before the replay")
+            ax.axvline(t_live[-1], color="tab:blue", lw=0.8, label="warm-up replay")
         # Grey: unobservable from the measurements of the horizon (held in the next scan).
         for n, (b, e) in enumerate(unobservable_spans(t, cols.get(status_key, []))):
             ax.axvspan(b, e, color="0.6", alpha=0.3, lw=0, label="unobservable" if n == 0 else None)

@@ -83,7 +83,8 @@ std::vector<double> UnobservableFraction(const RunSummary& run) {
   return fraction;
 }
 
-void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
+void WriteCalibrationLog(const std::string& path, const RunSummary& run,
+                         const std::vector<lio::ScanResult>* scans) {
   const lio::ScanResult* last = LastCalibration(run);
   const size_t imus = last != nullptr ? last->calibration.time_offset_s.size() : 0;
   std::ofstream f = io::OpenForWriting(path);
@@ -111,7 +112,7 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run) {
     for (const std::string& c : coordinates) f << ',' << c << "_information," << c << "_status";
   }
   f << "\n" << std::setprecision(10);
-  for (const lio::ScanResult& r : run.scans) {
+  for (const lio::ScanResult& r : scans != nullptr ? *scans : run.scans) {
     const auto& c = r.calibration;
     if (c.time_offset_s.size() != imus || (imus == 0 && !extrinsic)) continue;
     if (extrinsic && !c.has_extrinsic) continue;

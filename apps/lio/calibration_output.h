@@ -39,8 +39,10 @@ std::vector<double> UnobservableFraction(const RunSummary& run);
 // time_offset_j_sigma_s (NaN σ: not computed), then the extrinsic's columns when estimated, then
 // with the observability check per coordinate <name>_information (ν) and <name>_status
 // (observable | unobservable).
-// The write is checked (an error names the path).
-void WriteCalibrationLog(const std::string& path, const RunSummary& run);
+// The write is checked (an error names the path). `scans`: run.scans by default; after a warm-up
+// replay also run.warmup_live_scans (the estimates returned live before it), same columns.
+void WriteCalibrationLog(const std::string& path, const RunSummary& run,
+                         const std::vector<lio::ScanResult>* scans = nullptr);
 
 // The final estimates (and σ, and the truth where the source knows it) as YAML comments around a
 // `calibration:` mapping with time_offset_s; false (nothing written) without an estimate.

@@ -328,6 +328,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
         }
       }
       run.warmup_replayed_scans = r.revised_scans;
+      run.warmup_live_scans = odometry->warmup_results();
     }
     Tally(r, done - 1, T_imu_lidar, &run);
     if (r.status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {

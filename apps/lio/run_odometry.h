@@ -52,6 +52,7 @@ struct RunSummary {
   // start (the same as `trajectory` without a replay) with its ATE.
   int warmup_replayed_scans = 0;
   std::vector<io::StampedPose> live_trajectory;
+  std::vector<lio::ScanResult> warmup_live_scans;  // the replaced results, as returned live
   std::optional<AteResult> live_ate;
   int failed = 0, degenerate = 0, imu_gaps = 0;
   // Scans whose lidar term had at least one degenerate direction (lio/degeneracy.h), whatever

@@ -58,7 +58,43 @@ foreach(mode fixed calibrated)
         message(FATAL_ERROR "calibration.yaml lacks '${text}':\n${yaml}")
       endif()
     endforeach()
+    if(EXISTS ${OUT}/${mode}/calibration_live.csv)
+      message(FATAL_ERROR "calibration_live.csv written without a warm-up replay")
+    endif()
   elseif(EXISTS ${OUT}/${mode}/calibration.csv)
     message(FATAL_ERROR "calibration.csv written without calibration")
   endif()
 endforeach()
+
+# With a warm-up replay (calibration.warmup_replay_s, 0.5 s here): calibration.csv holds the
+# replayed estimates of every scan, calibration_live.csv the ones returned live up to the replay
+# (same columns, fewer rows), which the plot draws beside them; evaluation.txt says how many
+# scans the replay revised.
+file(WRITE ${OUT}/replay.yaml
+     "${base}\ncalibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 0.5\n")
+execute_process(
+  COMMAND ${EXE} --format sim --sim_regime medium --sim_index 100 --sim_duration 1
+          --sim_beams 16 --sim_firing_decimation 8 --sim_extrinsic_error=3deg,0.10m
+          --config ${OUT}/replay.yaml --method singer_lio --out ${OUT}/replayed
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "ctlio_odometry (replayed) failed (${rc}):\n${out}\n${err}")
+endif()
+file(STRINGS ${OUT}/replayed/calibration.csv rows)
+file(STRINGS ${OUT}/replayed/calibration_live.csv live)
+list(GET rows 0 header)
+list(GET live 0 live_header)
+if(NOT header STREQUAL live_header)
+  message(FATAL_ERROR "calibration_live.csv header differs:\n${live_header}\n${header}")
+endif()
+list(LENGTH rows n)
+list(LENGTH live n_live)
+if(n_live LESS 3 OR NOT n_live LESS n)
+  message(FATAL_ERROR "calibration_live.csv has ${n_live} lines, calibration.csv ${n}: expected "
+                      "the scans up to the replay only")
+endif()
+file(READ ${OUT}/replayed/evaluation.txt ev)
+string(REGEX MATCH "warmup_replayed_scans ([0-9]+)" m "${ev}")
+if(NOT m OR CMAKE_MATCH_1 EQUAL 0)
+  message(FATAL_ERROR "evaluation.txt does not report the replay:\n${ev}")
+endif()
