@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <stdexcept>
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
@@ -10,20 +11,36 @@
 
 namespace ctlio::lio {
 
-ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1,
-                                         const KnotKeys& k, const KnotKeys& k1,
+ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model,
+                                         const std::vector<TimedKnot>& knots,
                                          const std::vector<TimedPoint>& keypoints,
                                          SlidingWindow* window)
-    : keypoints_(keypoints), states_(KnotPair(k, k1)) {
-  for (int b = 0; b < 6; ++b) blocks_[b] = window->State(states_[b]);
+    : keypoints_(keypoints) {
+  if (knots.size() < 2) throw std::invalid_argument("ContinuousLidarTerm: need two knots or more");
+  for (size_t j = 0; j + 1 < knots.size(); ++j) {
+    if (!(knots[j].t < knots[j + 1].t)) {
+      throw std::invalid_argument("ContinuousLidarTerm: knot times must increase");
+    }
+    states_.push_back(KnotPair(knots[j].keys, knots[j + 1].keys));
+    SharedPoseInterpolation::KnotBlocks blocks;
+    for (int b = 0; b < 6; ++b) blocks[b] = window->State(states_.back()[b]);
+    blocks_.push_back(blocks);
+  }
+  newest_pose_ = blocks_.back()[3];
+  const double t_first = knots.front().t, t_last = knots.back().t;
   firing_.resize(keypoints.size());
   std::map<double, int> by_time;
   for (size_t i = 0; i < keypoints.size(); ++i) {
-    const double tau = std::clamp(keypoints[i].time, t_k, t_k1);
+    const double tau = std::clamp(keypoints[i].time, t_first, t_last);
     const auto [it, inserted] = by_time.try_emplace(tau, static_cast<int>(firings_.size()));
     if (inserted) {
+      // The interval that holds τ: the first whose end is not before it.
+      size_t j = 0;
+      while (j + 2 < knots.size() && tau > knots[j + 1].t) ++j;
+      interval_.push_back(static_cast<int>(j));
       firings_.push_back(std::make_shared<SharedPoseInterpolation>(
-          std::make_shared<const gp::GpInterpolator>(model, t_k, t_k1, tau), blocks_));
+          std::make_shared<const gp::GpInterpolator>(model, knots[j].t, knots[j + 1].t, tau),
+          blocks_[j]));
       window->shared_interpolations().Add(firings_.back());
     }
     firing_[i] = it->second;
@@ -59,13 +76,13 @@ ceres::ResidualBlockId ContinuousLidarTerm::AddResidual(size_t i,
   firing->set_active(true);
   if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
   if (extrinsic_ != nullptr) {
-    std::vector<StateId> states = states_;
+    std::vector<StateId> states = states_[static_cast<size_t>(interval_of(i))];
     states.push_back(kExtrinsicKey);
     costs_[i] = new ContinuousPointToPlaneExtrinsic(firing, association, points_lidar_[i]);
     return window->AddResidualBlock(costs_[i], loss, states);
   }
   costs_[i] = new ContinuousPointToPlane(firing, association);
-  return window->AddResidualBlock(costs_[i], loss, states_);
+  return window->AddResidualBlock(costs_[i], loss, states_[static_cast<size_t>(interval_of(i))]);
 }
 
 void ContinuousLidarTerm::UpdateResidual(size_t i, const PlaneAssociation& association) {
@@ -78,17 +95,17 @@ void ContinuousLidarTerm::UpdateResidual(size_t i, const PlaneAssociation& assoc
   }
 }
 
-ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1,
-                                         const KnotKeys& k, const KnotKeys& k1,
+ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model,
+                                         const std::vector<TimedKnot>& knots,
                                          const std::vector<TimedPoint>& keypoints,
                                          const SE3& T_robot_lidar, SlidingWindow* window)
-    : ContinuousLidarTerm(model, t_k, t_k1, k, k1, keypoints, window) {
+    : ContinuousLidarTerm(model, knots, keypoints, window) {
   extrinsic_ = window->State(kExtrinsicKey);
   const SE3 T_lidar_robot = T_robot_lidar.Inverse();
   points_lidar_.reserve(keypoints.size());
   for (const TimedPoint& p : keypoints) points_lidar_.push_back(T_lidar_robot * p.point);
 }
 
-SE3 ContinuousLidarTerm::NewestPose() const { return PoseManifold::Pose(blocks_[3]); }
+SE3 ContinuousLidarTerm::NewestPose() const { return PoseManifold::Pose(newest_pose_); }
 
 }  // namespace ctlio::lio

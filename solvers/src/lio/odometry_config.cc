@@ -113,6 +113,7 @@ void OdometryConfig::Validate() const {
   require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(window_knots >= 2, "window.knots must be >= 2");
+  require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
   require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
   for (const ImuSensor& s : imus) {
     require(s.accel_variance >= 0 && s.gyro_variance >= 0, "imus[].variances must be >= 0");
@@ -201,6 +202,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     } else if (key == "window") {
       ReadSection(v, section, source,
                   {{"knots", SetFromYaml(&c->window_knots)},
+                   {"knots_per_scan", SetFromYaml(&c->knots_per_scan)},
                    {"threads", SetFromYaml(&c->solver_threads)},
                    {"overlap", SetFromYaml(&c->overlap_stages)},
                    {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},

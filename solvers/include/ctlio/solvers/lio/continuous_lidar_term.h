@@ -1,5 +1,7 @@
-// The keypoints of a scan as measurements of the GP trajectory between two knots (SPEC §4): one
-// ContinuousPointToPlane per associated keypoint at its own time τ. The points of one firing
+// The keypoints of a scan as measurements of the GP trajectory over the knots that span the sweep
+// (SPEC §4; two knots, or more with window.knots_per_scan): one ContinuousPointToPlane per
+// associated keypoint at its own time τ, on the interval between the two knots around τ (a
+// point at an interior knot's time belongs to the interval that ends there). The points of one firing
 // (same τ) share one SharedPoseInterpolation (its gp::GpInterpolator's Λ, Ω depend on the times
 // only: built once per scan), which the window's evaluation callback fills once per evaluation
 // (SlidingWindow::shared_interpolations()) and the association reads at the current estimate.
@@ -20,20 +22,34 @@
 
 namespace ctlio::lio {
 
+// A knot of the window and its time.
+struct TimedKnot {
+  double t = 0.0;
+  KnotKeys keys;
+};
+
 class ContinuousLidarTerm final : public LidarTerm {
  public:
-  // Knots k (at t_k) and k1 (at t_k1 > t_k) are states of `window`; keypoints in the robot
-  // frame with times in [t_k, t_k1] (LioOdometry drops or clamps the points outside before they
-  // get here; the clamp inside only absorbs rounding, never extrapolates). The
+  // `knots` (at least two, times strictly increasing) are states of `window`; keypoints in the
+  // robot frame with times in [front.t, back.t] (LioOdometry drops or clamps the points outside
+  // before they get here; the clamp inside only absorbs rounding, never extrapolates). The
   // keypoints are referenced, not copied. Registers its firings with the window's callback.
-  ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
-                      const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
-                      SlidingWindow* window);
+  ContinuousLidarTerm(const gp::SingerModel<6>& model, const std::vector<TimedKnot>& knots,
+                      const std::vector<TimedPoint>& keypoints, SlidingWindow* window);
   // With the extrinsic T_rl estimated: the window's kExtrinsicKey block; `T_robot_lidar` is the
   // extrinsic the keypoints were moved into the robot frame with (PreparedScan::T_robot_lidar).
+  ContinuousLidarTerm(const gp::SingerModel<6>& model, const std::vector<TimedKnot>& knots,
+                      const std::vector<TimedPoint>& keypoints, const SE3& T_robot_lidar,
+                      SlidingWindow* window);
+  // Between two knots k (at t_k) and k1 (at t_k1 > t_k), without and with the extrinsic.
   ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
                       const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
-                      const SE3& T_robot_lidar, SlidingWindow* window);
+                      SlidingWindow* window)
+      : ContinuousLidarTerm(model, {{t_k, k}, {t_k1, k1}}, keypoints, window) {}
+  ContinuousLidarTerm(const gp::SingerModel<6>& model, double t_k, double t_k1, const KnotKeys& k,
+                      const KnotKeys& k1, const std::vector<TimedPoint>& keypoints,
+                      const SE3& T_robot_lidar, SlidingWindow* window)
+      : ContinuousLidarTerm(model, {{t_k, k}, {t_k1, k1}}, keypoints, T_robot_lidar, window) {}
 
   size_t num_keypoints() const override { return keypoints_.size(); }
   void BeginRound() override;
@@ -41,15 +57,20 @@ class ContinuousLidarTerm final : public LidarTerm {
   ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
                                      ceres::LossFunction* loss, SlidingWindow* window) override;
   void UpdateResidual(size_t i, const PlaneAssociation& association) override;
-  SE3 NewestPose() const override;  // T_rm of knot k1
+  SE3 NewestPose() const override;  // T_rm of the last knot
 
   int num_firings() const { return static_cast<int>(firings_.size()); }
+  // The interval (0 = between the first two knots) keypoint i is a measurement on.
+  int interval_of(size_t i) const { return interval_[static_cast<size_t>(firing_[i])]; }
 
  private:
   const std::vector<TimedPoint>& keypoints_;
-  std::vector<StateId> states_;  // pose, ϖ, ϖ̇ of k, then of k1
-  SharedPoseInterpolation::KnotBlocks blocks_;
-  std::vector<int> firing_;  // keypoint → firing
+  // Per interval between consecutive knots: pose, ϖ, ϖ̇ of its first knot, then of its second.
+  std::vector<std::vector<StateId>> states_;
+  std::vector<SharedPoseInterpolation::KnotBlocks> blocks_;
+  const double* newest_pose_ = nullptr;  // the last knot's T_rm block
+  std::vector<int> firing_;              // keypoint → firing
+  std::vector<int> interval_;            // firing → interval
   std::vector<std::shared_ptr<SharedPoseInterpolation>> firings_;
   // Per firing, this round: the map pose at the current estimate (for the association).
   std::vector<SE3> T_mr_;

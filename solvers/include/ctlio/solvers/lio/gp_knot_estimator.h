@@ -1,5 +1,7 @@
 // The states and factors of Singer-LIO (the paper's method, SPEC §2–§4): one GP knot
-// {T_rm, ϖ, ϖ̇, b} per scan end, the SE(3) Singer prior between knots, the gyro and the
+// {T_rm, ϖ, ϖ̇, b} per scan end (and with window.knots_per_scan = K > 1, K − 1 more at equal
+// spacing inside the sweep, so fast motion is not interpolated over a whole sweep), the SE(3)
+// Singer prior between knots, the gyro and the
 // accelerometer as measurements of the interpolated state at every IMU time (biases interpolated
 // linearly between knots, gravity C_mi from the initialisation), a bias random walk between
 // knots, and the keypoints as ContinuousPointToPlane residuals (ContinuousLidarTerm). The
@@ -47,11 +49,11 @@ class GpKnotEstimator final : public Estimator {
   void DropOldest() override { knots_.pop_front(); }
   double newest_time() const override { return knots_.back().t; }
   SE3 NewestPose() const override;
-  SE3 PreviousPose() const override;
+  SE3 PreviousPose() const override;  // at the previous scan's end
   StateId NewestPoseKey() const override { return knots_.back().keys.pose; }
   // T_rm: Exp(δ)·T_rm is the body motion T_mr·Exp(−δ).
   Mat6 NewestPoseTangentFromBody() const override { return -Mat6::Identity(); }
-  double previous_time() const override { return knots_[knots_.size() - 2].t; }
+  double previous_time() const override { return ScanStart().t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
 
@@ -73,6 +75,15 @@ class GpKnotEstimator final : public Estimator {
                const std::vector<Vec6>& bias, SlidingWindow* window);
   // T_mr(τ) between knots a and b from the current estimates (GP interpolation, SPEC §2).
   SE3 PoseAt(const Knot& a, const Knot& b, double tau) const;
+  // The knot at the previous scan's end (the newest before the last AddState), its index in
+  // knots_, and T_mr(τ) for τ in [ScanStart().t, newest_time()] on the interval between the
+  // knots around τ.
+  size_t ScanStartIndex() const;
+  const Knot& ScanStart() const { return knots_[ScanStartIndex()]; }
+  SE3 PoseSinceScanStart(double tau) const;
+  // One knot at t after the newest, with the motion prior, bias walk and IMU measurements of the
+  // interval between them.
+  void AddKnotAndFactors(double t, SlidingWindow* window, ScanResult* result);
   // Gyro and accelerometer samples of IMU `imu` in (prev.t, k.t] as measurements (SPEC §3).
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,
@@ -88,6 +99,7 @@ class GpKnotEstimator final : public Estimator {
   std::deque<Knot> knots_;                   // oldest first
   double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
+  int scan_knots_ = 0;  // knots the last AddState added (0 after Initialise)
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)

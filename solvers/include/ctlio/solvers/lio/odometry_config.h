@@ -95,6 +95,13 @@ struct OdometryConfig {
 
   // --- Window and solver.
   int window_knots = 2;    // newest knots kept free (SPEC §4: 2, the one before held)
+  // window.knots_per_scan (the GP methods; the baseline's states stay one per scan): K knots per
+  // sweep, at the sweep's end and at K − 1 equally spaced times inside it, so the trajectory
+  // between knots spans 1/K of a sweep (with 0.1 s sweeps, the fast regime's 4–8 Hz motion is
+  // interpolated coarsely; README "Online calibration"). The lidar residuals, IMU measurements,
+  // motion prior and bias walk go to the interval that holds their time; after the scan the
+  // window marginalises down to window_knots − 1 knots as before. 1 = the paper's knot per scan.
+  int knots_per_scan = 1;
   int solver_threads = 1;  // Ceres threads (iterations per round: lidar_frontend.solver_iterations)
   // window.overlap: scan k's voxel-map insertion and the marginalisation before scan k+1 run on a
   // second thread while scan k+1 is range-gated and subsampled (neither reads what the other
