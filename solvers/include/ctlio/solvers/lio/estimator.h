@@ -53,19 +53,21 @@ class Estimator {
   // and forgetting it once the window has marginalised it.
   virtual int num_states() const = 0;
   virtual std::vector<StateId> OldestKeys() const = 0;
-  // The keys of the newest state (its residual blocks are the newest interval's factors).
+  // The keys of the states the last AddState added (their residual blocks are the newest scan's
+  // factors): the newest state, or the sweep's knots with window.knots_per_scan > 1.
   virtual std::vector<StateId> NewestKeys() const = 0;
   virtual void DropOldest() = 0;
-  // Time (odometry seconds) and map pose T_mr of the newest and the previous state.
+  // Time (odometry seconds) and map pose T_mr of the newest state and of the state at the
+  // previous scan's end.
   virtual double newest_time() const = 0;
   virtual SE3 NewestPose() const = 0;
   virtual SE3 PreviousPose() const = 0;
   // The newest pose's state and A with δ_state = A·δ_body for its tangent (degeneracy.h).
   virtual StateId NewestPoseKey() const = 0;
   virtual Mat6 NewestPoseTangentFromBody() const = 0;
-  // Odometry time of the previous state, and the estimate T_mr at times `t` within [previous,
-  // newest] for a dense trajectory between the scan poses: GP interpolation between the two newest
-  // knots (SPEC §2) for the GP pipelines; for the baseline the IMU propagated from the previous
+  // Odometry time of the state at the previous scan's end, and the estimate T_mr at times `t`
+  // within [previous, newest] for a dense trajectory between the scan poses: GP interpolation
+  // between the knots around each time (SPEC §2) for the GP pipelines; for the baseline the IMU propagated from the previous
   // state and anchored at the newest, as its deskewing does.
   virtual double previous_time() const = 0;
   virtual std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const = 0;
