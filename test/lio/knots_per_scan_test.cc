@@ -82,10 +82,10 @@ TEST(KnotsPerScan, RejectsFewerThanTwoKnotsAndTimesThatDoNotIncrease) {
   const std::vector<TimedPoint> keypoints = {{Vec3(1, 2, 3), 0.05}};
   EXPECT_THROW(ContinuousLidarTerm(model, {{0.0, KnotKeys::ForKnot(0)}}, keypoints, &window),
                std::invalid_argument);
-  EXPECT_THROW(ContinuousLidarTerm(
-                   model, {{0.1, KnotKeys::ForKnot(0)}, {0.1, KnotKeys::ForKnot(1)}}, keypoints,
-                   &window),
-               std::invalid_argument);
+  EXPECT_THROW(
+      ContinuousLidarTerm(model, {{0.1, KnotKeys::ForKnot(0)}, {0.1, KnotKeys::ForKnot(1)}},
+                          keypoints, &window),
+      std::invalid_argument);
 }
 
 sim::SimConfig ShortSequence(sim::Regime regime) {

@@ -70,8 +70,8 @@ TEST(OdometryConfig, BadValuesAreErrors) {
   EXPECT_THROW(LoadOdometryConfig("/nonexistent/odometry.yaml"), std::runtime_error);
   EXPECT_THROW(ParseLioMethod("singer"), std::invalid_argument);
   for (const char* k : {"0", "11", "1.5"}) {
-    EXPECT_THROW(LoadOdometryConfig(WriteTemp("k.yaml", std::string("window:\n  knots_per_scan: ") +
-                                                            k + "\n")),
+    EXPECT_THROW(LoadOdometryConfig(
+                     WriteTemp("k.yaml", std::string("window:\n  knots_per_scan: ") + k + "\n")),
                  std::runtime_error)
         << k;
   }
@@ -79,8 +79,8 @@ TEST(OdometryConfig, BadValuesAreErrors) {
 
 TEST(OdometryConfig, KnotsPerScan) {
   EXPECT_EQ(OdometryConfig().knots_per_scan, 1);
-  EXPECT_EQ(LoadOdometryConfig(WriteTemp("k2.yaml", "window:\n  knots_per_scan: 2\n")).knots_per_scan,
-            2);
+  EXPECT_EQ(
+      LoadOdometryConfig(WriteTemp("k2.yaml", "window:\n  knots_per_scan: 2\n")).knots_per_scan, 2);
 }
 
 TEST(OdometryConfig, CalibrationSection) {

@@ -107,9 +107,7 @@ std::vector<SE3> GpKnotEstimator::PosesSincePrevious(const std::vector<double>& 
   return poses;
 }
 
-SE3 GpKnotEstimator::PreviousPose() const {
-  return PoseManifold::Pose(ScanStart().pose).Inverse();
-}
+SE3 GpKnotEstimator::PreviousPose() const { return PoseManifold::Pose(ScanStart().pose).Inverse(); }
 
 void GpKnotEstimator::Report(ScanResult* result) const {
   const Knot& k = knots_.back();
@@ -325,8 +323,8 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
     knots.push_back({knots_[i].t, knots_[i].keys});
   }
   if (estimates_extrinsic()) {
-    return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints,
-                                                 scan.T_robot_lidar, window);
+    return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, scan.T_robot_lidar,
+                                                 window);
   }
   return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
 }
@@ -334,8 +332,8 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
 std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
   const Knot& prev = ScanStart();
   const Knot& k = knots_.back();
-  // The GP pose on a 1 ms grid over the sweep's intervals, and between grid nodes the constant twist of
-  // the node pair (geodesic interpolation): the deviation from the GP mean is
+  // The GP pose on a 1 ms grid over the sweep's intervals, and between grid nodes the constant
+  // twist of the node pair (geodesic interpolation): the deviation from the GP mean is
   // ~½·|ω̇|·(0.5 ms)², 1.3e-5 rad at 100 rad/s² (0.6 mm at 50 m), while the 1 800 firings of a
   // sweep no longer each need their own GP interpolator.
   const int nodes = std::max(2, static_cast<int>(std::ceil((k.t - prev.t) / 1e-3)) + 1);

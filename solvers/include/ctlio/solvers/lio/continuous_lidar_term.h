@@ -1,13 +1,13 @@
 // The keypoints of a scan as measurements of the GP trajectory over the knots that span the sweep
 // (SPEC §4; two knots, or more with window.knots_per_scan): one ContinuousPointToPlane per
 // associated keypoint at its own time τ, on the interval between the two knots around τ (a
-// point at an interior knot's time belongs to the interval that ends there). The points of one firing
-// (same τ) share one SharedPoseInterpolation (its gp::GpInterpolator's Λ, Ω depend on the times
-// only: built once per scan), which the window's evaluation callback fills once per evaluation
-// (SlidingWindow::shared_interpolations()) and the association reads at the current estimate.
-// With the extrinsic estimated (online calibration, kExtrinsicKey in the window), every keypoint
-// is a ContinuousPointToPlaneExtrinsic of its lidar-frame point instead, and the association
-// places it with the extrinsic's current estimate.
+// point at an interior knot's time belongs to the interval that ends there). The points of one
+// firing (same τ) share one SharedPoseInterpolation (its gp::GpInterpolator's Λ, Ω depend on the
+// times only: built once per scan), which the window's evaluation callback fills once per
+// evaluation (SlidingWindow::shared_interpolations()) and the association reads at the current
+// estimate. With the extrinsic estimated (online calibration, kExtrinsicKey in the window), every
+// keypoint is a ContinuousPointToPlaneExtrinsic of its lidar-frame point instead, and the
+// association places it with the extrinsic's current estimate.
 #pragma once
 
 #include <array>

@@ -67,8 +67,8 @@ class Estimator {
   virtual Mat6 NewestPoseTangentFromBody() const = 0;
   // Odometry time of the state at the previous scan's end, and the estimate T_mr at times `t`
   // within [previous, newest] for a dense trajectory between the scan poses: GP interpolation
-  // between the knots around each time (SPEC §2) for the GP pipelines; for the baseline the IMU propagated from the previous
-  // state and anchored at the newest, as its deskewing does.
+  // between the knots around each time (SPEC §2) for the GP pipelines; for the baseline the IMU
+  // propagated from the previous state and anchored at the newest, as its deskewing does.
   virtual double previous_time() const = 0;
   virtual std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const = 0;
 

@@ -94,7 +94,7 @@ struct OdometryConfig {
   DegeneracyOptions degeneracy;
 
   // --- Window and solver.
-  int window_knots = 2;    // newest knots kept free (SPEC §4: 2, the one before held)
+  int window_knots = 2;  // newest knots kept free (SPEC §4: 2, the one before held)
   // window.knots_per_scan (the GP methods; the baseline's states stay one per scan): K knots per
   // sweep, at the sweep's end and at K − 1 equally spaced times inside it, so the trajectory
   // between knots spans 1/K of a sweep (with 0.1 s sweeps, the fast regime's 4–8 Hz motion is
