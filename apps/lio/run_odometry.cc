@@ -224,6 +224,16 @@ void ResetTally(RunSummary* run) {
 
 }  // namespace
 
+lio::LidarScan TakeLidarScan(io::ScanFrame* frame) {
+  lio::LidarScan scan;
+  scan.begin_ns = frame->start_ns;
+  scan.end_ns = frame->end_ns;
+  scan.points = std::move(frame->cloud.points);
+  scan.times_ns = std::move(frame->cloud.times_ns);
+  if (scan.times_ns.empty()) scan.times_ns.assign(scan.points.size(), scan.end_ns);
+  return scan;
+}
+
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options, double failure_ate) {
   RunSummary run;
@@ -288,13 +298,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
            io::FormatSecondsNs(previous_end) + " s");
       continue;
     }
-    lio::LidarScan scan;
-    scan.begin_ns = frame.start_ns;
-    scan.end_ns = frame.end_ns;
-    scan.points = std::move(frame.cloud.points);
-    scan.times_ns = std::move(frame.cloud.times_ns);
-    if (scan.times_ns.empty()) scan.times_ns.assign(scan.points.size(), scan.end_ns);
-    const lio::ScanResult r = odometry->AddScan(scan);
+    const lio::ScanResult r = odometry->AddScan(TakeLidarScan(&frame));
     run.imu_rejected += r.imu_rejected;
     run.points_dropped += r.points_dropped;
     if (r.imu_rejected > 0 || r.points_dropped > 0 || r.status == lio::ScanStatus::kSuspect) {

@@ -107,6 +107,11 @@ inline constexpr double kDriftWindow = 10.0;  // m
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options = {}, double failure_ate = 1.0);
 
+// A dataset frame's sweep as the odometry's input: its points and per-point times are moved out
+// of *frame (the rest of the frame stays); a cloud without per-point times gets the scan end for
+// every point.
+lio::LidarScan TakeLidarScan(io::ScanFrame* frame);
+
 // The config's IMU list from the source's IMUs when the config gives none (`imus:`) and the
 // source has more than one IMU or an IMU away from the body frame: each IMU's mounting, and its
 // variances scaled from the config's (which describe the first IMU) by the source's stated noise,

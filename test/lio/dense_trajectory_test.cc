@@ -3,6 +3,7 @@
 // the scan pose, and follows the truth between the scans as closely as the scan poses do.
 #include <gtest/gtest.h>
 
+#include "common/dense_trajectory_checks.h"
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -27,18 +28,8 @@ TEST(DenseTrajectory, EndsAtTheScanPosesAndFollowsTheTruth) {
     const auto& dense = run.dense;
     // ~100 poses over 0.9 s of estimated intervals plus the first pose.
     EXPECT_GE(dense.size(), 80u);
-    for (size_t i = 1; i < dense.size(); ++i) {
-      ASSERT_GT(dense[i].t_ns, dense[i - 1].t_ns);
-      EXPECT_LE(dense[i].t_ns - dense[i - 1].t_ns, 10'000'000);
-    }
-    // Every scan pose is in the dense trajectory, exactly.
-    size_t j = 0;
-    for (const io::StampedPose& p : run.trajectory) {
-      while (j < dense.size() && dense[j].t_ns < p.t_ns) ++j;
-      ASSERT_LT(j, dense.size());
-      ASSERT_EQ(dense[j].t_ns, p.t_ns);
-      EXPECT_LT((dense[j].pose.translation() - p.pose.translation()).norm(), 1e-12);
-    }
+    // A pose every 10 ms, and every scan pose in the dense trajectory, exactly.
+    ASSERT_NO_FATAL_FAILURE(testing::ExpectDenseThroughTheScanPoses(run, 10'000'000));
     // Between the scans it tracks the truth about as well as at the scans (a straight line between
     // scan poses would be off by the motion within 0.1 s).
     const auto truth = source.GroundTruth();

@@ -13,6 +13,7 @@
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "ctlio/solvers/lio/state_keys.h"
+#include "lio/run_odometry.h"
 
 namespace ctlio::lio {
 namespace {
@@ -38,12 +39,7 @@ std::unique_ptr<LioOdometry> RunSequence(const sim::SimConfig& sim_config, Odome
   io::ScanFrame f;
   while (source.Next(&f)) {
     for (const io::ImuSample& x : f.imu) odometry->AddImu(x);
-    LidarScan s;
-    s.begin_ns = f.start_ns;
-    s.end_ns = f.end_ns;
-    s.points = f.cloud.points;
-    s.times_ns = f.cloud.times_ns;
-    results->push_back(odometry->AddScan(s));
+    results->push_back(odometry->AddScan(lioapp::TakeLidarScan(&f)));
   }
   return odometry;
 }

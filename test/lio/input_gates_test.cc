@@ -140,11 +140,7 @@ std::vector<ScanResult> RunLibrary(
       if (edit_imu) edit_imu(&s);
       odometry.AddImu(s);
     }
-    LidarScan scan;
-    scan.begin_ns = f.start_ns;
-    scan.end_ns = f.end_ns;
-    scan.points = f.cloud.points;
-    scan.times_ns = f.cloud.times_ns;
+    LidarScan scan = lioapp::TakeLidarScan(&f);
     if (edit_scan) edit_scan(results.size(), previous_end, &scan);
     previous_end = scan.end_ns;
     results.push_back(odometry.AddScan(scan));

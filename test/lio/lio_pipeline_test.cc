@@ -28,15 +28,6 @@ OdometryConfig Config(LioMethod method) {
   return c;
 }
 
-LidarScan ToScan(io::ScanFrame& f) {
-  LidarScan s;
-  s.begin_ns = f.start_ns;
-  s.end_ns = f.end_ns;
-  s.points = f.cloud.points;
-  s.times_ns = f.cloud.times_ns;
-  return s;
-}
-
 // Bounds: on this sparse 16-beam, 1 s sequence Singer-LIO measured 4.2 cm over 1.5 s and
 // ~1 cm with 32 beams; the bounds leave margin for the scheduling noise of the solver.
 TEST(LioPipeline, SingerLioAndBaselineTrackShortSimulatedSequence) {
@@ -178,7 +169,7 @@ TEST(LioPipeline, ImuGapAndDegenerateScanAreReportedAndSurvived) {
         if (k == 5 && s.t_ns > f.start_ns && s.t_ns < f.end_ns - 5'000'000) continue;
         odometry->AddImu(s);
       }
-      LidarScan scan = ToScan(f);
+      LidarScan scan = lioapp::TakeLidarScan(&f);
       if (k == 8) {  // a scan that sees almost nothing
         scan.points.resize(20);
         scan.times_ns.resize(20);
@@ -225,7 +216,7 @@ TEST(LioPipeline, LeavingKnotsAreMarginalisedIntoAnInformativePrior) {
   int scans = 0;
   while (source.Next(&f)) {
     for (const auto& x : f.imu) odometry->AddImu(x);
-    const ScanResult r = odometry->AddScan(ToScan(f));
+    const ScanResult r = odometry->AddScan(lioapp::TakeLidarScan(&f));
     ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
     ++scans;
   }

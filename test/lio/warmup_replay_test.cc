@@ -36,11 +36,7 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   int64_t first_begin = 0, previous_end = 0;
   while (source.Next(&frame)) {
     for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
-    LidarScan scan;
-    scan.begin_ns = frame.start_ns;
-    scan.end_ns = frame.end_ns;
-    scan.points = frame.cloud.points;
-    scan.times_ns = frame.cloud.times_ns;
+    const LidarScan scan = lioapp::TakeLidarScan(&frame);
     if (scans == 0) first_begin = scan.begin_ns;
     const ScanResult r = odometry.AddScan(scan);
     ++scans;
