@@ -7,11 +7,10 @@ file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 file(READ ${SOURCE_DIR}/data/sim_lio.yaml base)
 file(WRITE ${OUT}/calibration.yaml "${base}\ncalibration:\n  estimate_extrinsic: true\n")
-foreach(mode fixed calibrated)
-  set(config ${SOURCE_DIR}/data/sim_lio.yaml)
-  if(mode STREQUAL "calibrated")
-    set(config ${OUT}/calibration.yaml)
-  endif()
+
+# Singer-LIO on the tiny sequence with the 3° / 10 cm nominal extrinsic, config `config`, into
+# ${OUT}/${mode}; a failure stops the test with the program's output.
+function(run_odometry mode config)
   execute_process(
     COMMAND ${EXE} --format sim --sim_regime medium --sim_index 100 --sim_duration 1
             --sim_beams 16 --sim_firing_decimation 8 --sim_extrinsic_error=3deg,0.10m
@@ -20,6 +19,14 @@ foreach(mode fixed calibrated)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "ctlio_odometry (${mode}) failed (${rc}):\n${out}\n${err}")
   endif()
+endfunction()
+
+foreach(mode fixed calibrated)
+  set(config ${SOURCE_DIR}/data/sim_lio.yaml)
+  if(mode STREQUAL "calibrated")
+    set(config ${OUT}/calibration.yaml)
+  endif()
+  run_odometry(${mode} ${config})
   file(READ ${OUT}/${mode}/evaluation.txt ev)
   set(expected "extrinsic_initial_error_deg 3\n" "extrinsic_initial_error_cm 10\n")
   if(mode STREQUAL "fixed")
@@ -72,14 +79,7 @@ endforeach()
 # scans the replay revised.
 file(WRITE ${OUT}/replay.yaml
      "${base}\ncalibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 0.5\n")
-execute_process(
-  COMMAND ${EXE} --format sim --sim_regime medium --sim_index 100 --sim_duration 1
-          --sim_beams 16 --sim_firing_decimation 8 --sim_extrinsic_error=3deg,0.10m
-          --config ${OUT}/replay.yaml --method singer_lio --out ${OUT}/replayed
-  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "ctlio_odometry (replayed) failed (${rc}):\n${out}\n${err}")
-endif()
+run_odometry(replayed ${OUT}/replay.yaml)
 file(STRINGS ${OUT}/replayed/calibration.csv rows)
 file(STRINGS ${OUT}/replayed/calibration_live.csv live)
 list(GET rows 0 header)
