@@ -85,6 +85,10 @@ DEFINE_double(max_imu_gap_error, 0.0,
               "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
               "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
+DEFINE_double(play_rate, 0.0,
+              "Give each scan to the odometry at its own time on the wall clock, sped up by this "
+              "factor (1 = the sensor's pace, as rosbag play -r): the per-scan ms are then the "
+              "latency from a sweep's arrival to its pose; 0 = back to back (the default)");
 DEFINE_int32(frontend_threads, 1,
              "Threads of the lidar front end (association, range gate): lidar_frontend.threads "
              "of the config unless given; same results as one thread");
@@ -289,6 +293,9 @@ int main(int argc, char** argv) {
     const bool gap_flag = !gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default;
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     if (FLAGS_max_scans < 0) throw std::runtime_error("--max_scans must be >= 0 (0 = all)");
+    if (!(FLAGS_play_rate >= 0.0) || !std::isfinite(FLAGS_play_rate)) {
+      throw std::runtime_error("--play_rate must be a finite number >= 0 (0 = back to back)");
+    }
     std::vector<lioapp::RunSummary> runs;
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
@@ -315,6 +322,7 @@ int main(int argc, char** argv) {
       options.max_scans = static_cast<size_t>(FLAGS_max_scans);
       options.extrinsic_from_config = config_extrinsic;
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
+      options.play_rate = FLAGS_play_rate;
       if (FLAGS_progress) {
         options.progress = [&m](size_t done, size_t total, const lio::ScanResult& r) {
           std::fprintf(stderr, "\r[%s] scan %zu/%zu  %-12s %5d assoc  %6.1f ms   ", m.c_str(), done,

@@ -5,11 +5,15 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
+#include <utility>
 
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
@@ -289,6 +293,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   SE3 live_from_replay;  // identity until a calibration warm-up replay
   size_t done = 0;
+  std::optional<std::pair<std::chrono::steady_clock::time_point, int64_t>> pace_origin;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
     for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
     if (have_previous && frame.end_ns <= previous_end) {
@@ -297,6 +302,13 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
            io::FormatSecondsNs(frame.end_ns) + " s is not after the previous scan's " +
            io::FormatSecondsNs(previous_end) + " s");
       continue;
+    }
+    if (options.play_rate > 0.0) {
+      if (!pace_origin) pace_origin.emplace(std::chrono::steady_clock::now(), frame.end_ns);
+      const double seconds = 1e-9 * double(frame.end_ns - pace_origin->second) / options.play_rate;
+      std::this_thread::sleep_until(pace_origin->first +
+                                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>(seconds)));
     }
     const lio::ScanResult r = odometry->AddScan(TakeLidarScan(&frame));
     run.imu_rejected += r.imu_rejected;

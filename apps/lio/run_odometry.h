@@ -23,6 +23,11 @@ struct RunOptions {
   bool extrinsic_from_config = false;
   // > 0: also sample the estimate at this rate between the scan poses (RunSummary::dense).
   double trajectory_rate_hz = 0.0;
+  // > 0: each scan is given to the odometry no earlier than its end time after the first scan's,
+  // divided by this factor, on the wall clock (1 = the sensor's own pace, as `rosbag play -r`):
+  // ScanResult::milliseconds is then the latency from a sweep's arrival to its pose, with the
+  // idle time between sweeps what a robot has (window.overlap uses it). 0: back to back.
+  double play_rate = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
 };

@@ -213,9 +213,14 @@ TEST(Frontend, RangeGatedVoxelIndicesMatchesReferenceForAnyThreads) {
     if (seen.insert(key).second) reference.push_back(i);
   }
   ASSERT_GT(reference.size(), 10000u);
+  // The buffer form (the odometry's, reused from sweep to sweep) starts from what it is given:
+  // stale indices of a longer earlier sweep must not survive into the next result.
+  std::vector<size_t> reused(reference.size() + 100, 7);
   for (const int threads : {1, 2, 3}) {
     EXPECT_EQ(RangeGatedVoxelIndices(raw, 0.5, 1.0, 40.0, threads), reference)
         << threads << " threads";
+    RangeGatedVoxelIndices(raw, 0.5, 1.0, 40.0, threads, &reused);
+    EXPECT_EQ(reused, reference) << threads << " threads, reused buffer";
   }
 }
 

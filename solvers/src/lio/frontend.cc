@@ -209,8 +209,16 @@ void FirstOfVoxelInBand(const std::vector<Vec3>& points, size_t begin, size_t en
 
 std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
                                            double min_range, double max_range, int threads) {
+  std::vector<size_t> out;
+  RangeGatedVoxelIndices(points, voxel_size, min_range, max_range, threads, &out);
+  return out;
+}
+
+void RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size, double min_range,
+                            double max_range, int threads, std::vector<size_t>* out) {
   if (!(voxel_size > 0.0)) throw std::invalid_argument("RangeGatedVoxelIndices: voxel_size <= 0");
-  if (points.empty()) return {};
+  out->clear();
+  if (points.empty()) return;
   const double inverse_size = 1.0 / voxel_size;
   const double min2 = min_range * min_range, max2 = max_range * max_range;
   // Reused across calls: fresh tables per sweep cost allocations and page faults.
@@ -235,17 +243,16 @@ std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, doub
       FirstOfVoxelInBand<false>(points, begin, end, inverse_size, min2, max2, &seen[c], &kept[c]);
     }
   });
-  std::vector<size_t> out(kept[0]);
+  out->assign(kept[0].begin(), kept[0].end());
   for (size_t c = 1; c < chunks; ++c) {
     for (const size_t i : kept[c]) {
       uint64_t key;
       PackedKey(points[i], inverse_size, &key);
       bool earlier = false;
       for (size_t e = 0; e < c && !earlier; ++e) earlier = seen[e].Contains(key);
-      if (!earlier) out.push_back(i);
+      if (!earlier) out->push_back(i);
     }
   }
-  return out;
 }
 
 double LidarFrontend::NextVoxelSize() const {
@@ -328,8 +335,9 @@ void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3&
   selection->indices.clear();
   selection->points_robot.clear();
   selection->keypoints.clear();
-  const std::vector<size_t> first = RangeGatedVoxelIndices(sweep_lidar, size, options_.min_range,
-                                                           options_.max_range, options_.threads);
+  thread_local std::vector<size_t> first;  // reused: a fresh one per sweep faulted its pages in
+  RangeGatedVoxelIndices(sweep_lidar, size, options_.min_range, options_.max_range,
+                         options_.threads, &first);
   selection->indices.reserve(first.size());
   selection->points_robot.reserve(first.size());
   // C·p + r with C = I, r = 0 is p itself for a finite p (1·x + 0·y + 0·z + 0 = x; −0 becomes +0,

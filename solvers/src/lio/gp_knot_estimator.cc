@@ -329,7 +329,7 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
   return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
 }
 
-std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
+void GpKnotEstimator::MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const {
   const Knot& prev = ScanStart();
   const Knot& k = knots_.back();
   // The GP pose on a 1 ms grid over the sweep's intervals, and between grid nodes the constant
@@ -347,8 +347,8 @@ std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
   const bool recalibrate = extrinsic_ != nullptr;
   const SE3 correction =
       recalibrate ? PoseManifold::Pose(extrinsic_) * scan.T_robot_lidar.Inverse() : SE3();
-  std::vector<Vec3> map_points;
-  map_points.reserve(scan.points.size());
+  out->clear();
+  out->reserve(scan.points.size());
   double last_tau = -1.0;
   SE3 T_mr_tau;
   for (const TimedPoint& p : scan.points) {
@@ -359,9 +359,8 @@ std::vector<Vec3> GpKnotEstimator::MapPoints(const PreparedScan& scan) const {
       if (recalibrate) T_mr_tau = T_mr_tau * correction;
       last_tau = p.time;
     }
-    map_points.push_back(T_mr_tau * p.point);
+    out->push_back(T_mr_tau * p.point);
   }
-  return map_points;
 }
 
 }  // namespace ctlio::lio

@@ -194,7 +194,7 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
   result.points_dropped = static_cast<int>(input.points.size() - scan.points.size());
   const SE3 T_robot_lidar = CurrentExtrinsic();
   std::future<std::pair<double, double>> overlapped = StartOverlappedStages();
-  const PreparedScan prepared = PrepareScan(scan, T_robot_lidar);
+  const PreparedScan& prepared = PrepareScan(scan, T_robot_lidar);
   result.ms_preprocess = MsSince(start);
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
@@ -300,12 +300,16 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const auto t_map = std::chrono::steady_clock::now();
   if (EstimatePlausible(result)) {
-    if (config_.overlap_stages) {  // inserted during the next scan's preprocessing
-      pending_map_points_ = estimator_->MapPoints(scan);
+    if (config_.overlap_stages) {
+      // Inserted on a second thread from now on: in real time, while the robot waits for the
+      // next sweep; back to back, beside the rest of this scan and the next one's preprocessing.
+      // Joined before anything reads the map (StartOverlappedStages' task, or RunScan).
+      estimator_->MapPoints(scan, &pending_map_points_);
       pending_map_position_ = estimator_->NewestPose().translation();
-      map_pending_ = true;
+      StartMapInsertion();
     } else {
-      frontend_.UpdateMap(estimator_->MapPoints(scan), estimator_->NewestPose().translation());
+      estimator_->MapPoints(scan, &map_points_);
+      frontend_.UpdateMap(map_points_, estimator_->NewestPose().translation());
     }
   }
   if (registered.degenerate) ReportDegenerate(result);
@@ -482,29 +486,34 @@ SE3 LioOdometry::CurrentExtrinsic() const {
   return window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
 }
 
+void LioOdometry::StartMapInsertion() {
+  map_insertion_ = std::async(std::launch::async, [this] {
+    const auto t0 = std::chrono::steady_clock::now();
+    frontend_.UpdateMap(pending_map_points_, pending_map_position_);
+    pending_map_points_.clear();
+    return MsSince(t0);
+  });
+}
+
 std::future<std::pair<double, double>> LioOdometry::StartOverlappedStages() {
   slid_ = false;
-  if (!config_.overlap_stages || (!map_pending_ && !initialised_)) return {};
+  if (!config_.overlap_stages || (!map_insertion_.valid() && !initialised_)) return {};
   // Process slides first thing (Initialise does not): done here beside the preprocessing, which
-  // reads neither the map nor the window (its extrinsic was read before).
+  // reads neither the map nor the window (its extrinsic was read before), after the previous
+  // scan's map insertion on the same second thread (waited for there, not here).
   const bool slide = initialised_;
   slid_ = slide;
-  return std::async(std::launch::async, [this, slide] {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (map_pending_) {
-      frontend_.UpdateMap(pending_map_points_, pending_map_position_);
-      map_pending_ = false;
-      pending_map_points_.clear();
-    }
-    const double ms_map = MsSince(t0);
+  std::future<double> insertion = std::move(map_insertion_);
+  return std::async(std::launch::async, [this, slide, insertion = std::move(insertion)]() mutable {
+    const double ms_map = insertion.valid() ? insertion.get() : 0.0;
     return std::make_pair(ms_map, slide ? SlideWindow() : 0.0);
   });
 }
 
-PreparedScan LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar) {
+const PreparedScan& LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar) {
   const double t_prev =
       initialised_ ? imu_.Seconds(last_scan_end_ns_) : imu_.Seconds(scan.begin_ns);
-  PreparedScan prepared;
+  PreparedScan& prepared = prepared_;
   prepared.t_begin = imu_.Seconds(scan.begin_ns);
   prepared.t_end = imu_.Seconds(scan.end_ns);
   prepared.end_ns = scan.end_ns;
@@ -526,6 +535,7 @@ PreparedScan LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T_robot_
     // so Preprocess's time check (RangeGate) would keep every point.
     p.time = std::clamp(imu_.Seconds(scan.times_ns[selection.indices[j]]), t_prev, prepared.t_end);
   }
+  prepared.keypoints.clear();
   prepared.keypoints.reserve(selection.keypoints.size());
   for (const size_t j : selection.keypoints) prepared.keypoints.push_back(prepared.points[j]);
   SortByTime(&prepared.points);

@@ -239,14 +239,13 @@ std::unique_ptr<LidarTerm> NavStateEstimator::MakeLidarTerm(const PreparedScan& 
                                              scan.keypoints);
 }
 
-std::vector<Vec3> NavStateEstimator::MapPoints(const PreparedScan& scan) const {
+void NavStateEstimator::MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const {
   const State& s = states_.back();
   const DeskewTable table = Deskew(states_[states_.size() - 2], s);
   const SE3 T_wb = PoseManifold::Pose(s.pose);
-  std::vector<Vec3> map_points;
-  map_points.reserve(scan.points.size());
-  for (const TimedPoint& p : scan.points) map_points.push_back(T_wb * table.ToEnd(p.time, p.point));
-  return map_points;
+  out->clear();
+  out->reserve(scan.points.size());
+  for (const TimedPoint& p : scan.points) out->push_back(T_wb * table.ToEnd(p.time, p.point));
 }
 
 }  // namespace ctlio::lio

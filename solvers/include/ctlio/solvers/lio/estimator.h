@@ -44,8 +44,10 @@ class Estimator {
   // The scan's keypoints as a measurement of the newest states (for ScanRegistration).
   virtual std::unique_ptr<LidarTerm> MakeLidarTerm(const PreparedScan& scan,
                                                    SlidingWindow* window) const = 0;
-  // Every preprocessed point in the map frame, each moved by the estimated motion at its time.
-  virtual std::vector<Vec3> MapPoints(const PreparedScan& scan) const = 0;
+  // Every preprocessed point in the map frame, each moved by the estimated motion at its time,
+  // written into *out (its capacity is reused: a sweep's ~50 000 points are megabytes, which a
+  // fresh vector per scan faults in page by page).
+  virtual void MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const = 0;
   // Writes the newest state's estimate (pose, velocity, bias) into the result.
   virtual void Report(ScanResult* result) const = 0;
 

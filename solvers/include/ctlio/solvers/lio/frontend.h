@@ -36,6 +36,9 @@ std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points
 // order (same indices).
 std::vector<size_t> RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size,
                                            double min_range, double max_range, int threads = 1);
+// The same into *out (cleared; its capacity is reused from sweep to sweep).
+void RangeGatedVoxelIndices(const std::vector<Vec3>& points, double voxel_size, double min_range,
+                            double max_range, int threads, std::vector<size_t>* out);
 
 // PCA of the neighbours; false for fewer than three points or a degenerate (zero-spread) set.
 bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane);

@@ -40,7 +40,7 @@ class GpKnotEstimator final : public Estimator {
   void AddState(const PreparedScan& scan, SlidingWindow* window, ScanResult* result) override;
   std::unique_ptr<LidarTerm> MakeLidarTerm(const PreparedScan& scan,
                                            SlidingWindow* window) const override;
-  std::vector<Vec3> MapPoints(const PreparedScan& scan) const override;
+  void MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const override;
   void Report(ScanResult* result) const override;
 
   int num_states() const override { return static_cast<int>(knots_.size()); }

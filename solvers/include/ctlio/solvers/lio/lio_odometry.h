@@ -93,14 +93,18 @@ class LioOdometry {
                                              std::string* note) const;
   // Robot-frame points (T_robot_lidar: the extrinsic or its estimate), range gate, voxel
   // subsampling, keypoints, time order. Times within the tolerance outside the interval (driver
-  // clock jitter) are clamped onto it.
-  PreparedScan PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar);
+  // clock jitter) are clamped onto it. Into prepared_ (its buffers' capacity is reused: fresh
+  // megabyte vectors per scan were page faults in every scan), which the reference returned is.
+  const PreparedScan& PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar);
   // The extrinsic the next scan is prepared with: its online estimate, or the configured one.
   SE3 CurrentExtrinsic() const;
   // config.overlap_stages: the previous scan's map insertion and, before a registration, the
   // marginalisation, on a second thread; returns their wall ms (map, marginalise), or no future
   // without the overlap.
   std::future<std::pair<double, double>> StartOverlappedStages();
+  // config.overlap_stages: inserts pending_map_points_ into the map on a second thread, started
+  // as soon as the scan's pose is estimated (map_insertion_ returns its wall ms).
+  void StartMapInsertion();
   // First scan: gravity initialisation (with an IMU), the first state, the map.
   void Initialise(const PreparedScan& scan, ScanResult* result);
   // Every later scan.
@@ -170,12 +174,13 @@ class LioOdometry {
   std::unique_ptr<CalibrationObservability> observability_;
   std::vector<ceres::ResidualBlockId> holds_;
   int num_marginalizations_ = 0;
-  // config.overlap_stages: the map insertion left for the next scan, and whether this scan's
-  // marginalisation is done (overlapped with its preprocessing).
+  // config.overlap_stages: the points the second thread inserts (StartMapInsertion), and whether
+  // this scan's marginalisation is done (overlapped with its preprocessing).
   std::vector<Vec3> pending_map_points_;
   Vec3 pending_map_position_ = Vec3::Zero();
-  bool map_pending_ = false;
   bool slid_ = false;
+  PreparedScan prepared_;         // the scan being processed (PrepareScan)
+  std::vector<Vec3> map_points_;  // its points in the map frame (MapPoints), reused
   // Warm-up replay (calibration.warmup_replay_s): every IMU sample and scan of the span as given
   // (each scan with the number of samples added before it), the pipeline that replayed them
   // (every call is forwarded to it from then on), and the live results it replaced.
@@ -184,6 +189,9 @@ class LioOdometry {
   std::unique_ptr<LioOdometry> replay_;
   std::vector<ScanResult> warmup_results_;
   bool warmup_done_ = false;
+  // The running map insertion (StartMapInsertion). Last: destroyed first, which waits for it
+  // while the map and the points it reads still exist.
+  std::future<double> map_insertion_;
 };
 
 // The pipeline of config.method.

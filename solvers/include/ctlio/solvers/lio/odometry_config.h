@@ -104,9 +104,10 @@ struct OdometryConfig {
   int knots_per_scan = 1;
   int solver_threads = 1;  // Ceres threads (iterations per round: lidar_frontend.solver_iterations)
   // window.overlap: scan k's voxel-map insertion and the marginalisation before scan k+1 run on a
-  // second thread while scan k+1 is range-gated and subsampled (neither reads what the other
-  // writes), instead of one after the other on the scan thread. The same estimates, bit for bit;
-  // AddScan returns once scan k's pose is estimated, its map insertion runs during the next call.
+  // second thread, instead of one after the other on the scan thread: the insertion from the
+  // moment scan k's pose is estimated (in real time it ends while the robot waits for the next
+  // sweep), the marginalisation beside scan k+1's range gate and subsampling (neither reads what
+  // the other writes). The same estimates, bit for bit.
   bool overlap_stages = false;
   bool estimate_gravity = false;  // hold C_mi after initialisation (paper) or refine it
 
