@@ -38,8 +38,8 @@ int32_t VoxelMap::Find(const VoxelKey& key) const {
   if (slots_.empty()) return kNoVoxel;
   const uint64_t mask = slots_.size() - 1;
   for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
-    const Slot& slot = slots_[s];
-    if (slot.voxel == kNoVoxel || slot.key == key) return slot.voxel;
+    const int32_t voxel = slots_[s];
+    if (voxel == kNoVoxel || keys_[voxel] == key) return voxel;
   }
 }
 
@@ -47,16 +47,15 @@ int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
   if (2 * (keys_.size() + 1) > slots_.size()) Rehash(2 * (keys_.size() + 1));
   const uint64_t mask = slots_.size() - 1;
   for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
-    Slot& slot = slots_[s];
-    if (slot.voxel != kNoVoxel) {
-      if (slot.key == key) return slot.voxel;
+    int32_t& slot = slots_[s];
+    if (slot != kNoVoxel) {
+      if (keys_[slot] == key) return slot;
       continue;
     }
     if (keys_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
       throw std::length_error("VoxelMap: more than 2^31 voxels");
     }
-    slot.key = key;
-    slot.voxel = static_cast<int32_t>(keys_.size());
+    slot = static_cast<int32_t>(keys_.size());
     keys_.push_back(key);
     counts_.push_back(0);
     if (options_.fit_planes) {
@@ -67,19 +66,19 @@ int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
     if ((keys_.size() - 1) >> kChunkBits >= pool_.size()) {
       pool_.emplace_back(new Vec3[(size_t{1} << kChunkBits) * stride_]);
     }
-    return slot.voxel;
+    return slot;
   }
 }
 
 void VoxelMap::Rehash(size_t min_slots) {
   size_t n = 1024;
   while (n < min_slots) n *= 2;
-  slots_.assign(n, Slot{});
+  slots_.assign(n, kNoVoxel);
   const uint64_t mask = n - 1;
   for (size_t i = 0; i < keys_.size(); ++i) {
     uint64_t s = HashOf(keys_[i]) & mask;
-    while (slots_[s].voxel != kNoVoxel) s = (s + 1) & mask;
-    slots_[s] = {keys_[i], static_cast<int32_t>(i)};
+    while (slots_[s] != kNoVoxel) s = (s + 1) & mask;
+    slots_[s] = static_cast<int32_t>(i);
   }
 }
 
