@@ -175,7 +175,7 @@ class VoxelMap {
   Options options_;
   double inverse_voxel_size_;
   double min_distance2_;
-  size_t stride_;                              // max_points_per_voxel
+  size_t stride_;  // max_points_per_voxel
   // Voxel index per slot (kNoVoxel: empty), power-of-two size or empty; the key is compared in
   // keys_. 4 bytes a slot rather than the key's 12 more: the table of a mapped room (~1 MB with
   // the keys) stays in L2, where a lookup was an L3 miss.
