@@ -178,8 +178,9 @@ std::string FormatSecondsNs(int64_t ns) {
   char buf[48];
   const bool neg = ns < 0;
   const uint64_t a = neg ? uint64_t(-(ns + 1)) + 1 : uint64_t(ns);
-  std::snprintf(buf, sizeof(buf), "%s%" PRIu64 ".%09" PRIu64, neg ? "-" : "", a / 1000000000ULL,
-                a % 1000000000ULL);
+  constexpr uint64_t kNsPerS = 1000000000;  // uint64_t, as PRIu64 expects (not unsigned long long)
+  std::snprintf(buf, sizeof(buf), "%s%" PRIu64 ".%09" PRIu64, neg ? "-" : "", a / kNsPerS,
+                a % kNsPerS);
   return buf;
 }
 
