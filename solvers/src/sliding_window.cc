@@ -207,6 +207,7 @@ ceres::ResidualBlockId SlidingWindow::AddResidualBlock(ceres::CostFunction* cost
                         ")");
   }
   std::vector<double*> blocks;
+  blocks.reserve(states.size());
   for (size_t i = 0; i < states.size(); ++i) {
     const StateBlock& block = Get(states[i], __LINE__);
     if (block.ambient_size != sizes[i]) {
