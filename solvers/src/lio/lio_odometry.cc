@@ -300,16 +300,15 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const auto t_map = std::chrono::steady_clock::now();
   if (EstimatePlausible(result)) {
+    estimator_->MapPoints(scan, &map_points_);
+    map_position_ = estimator_->NewestPose().translation();
     if (config_.overlap_stages) {
       // Inserted on a second thread from now on: in real time, while the robot waits for the
       // next sweep; back to back, beside the rest of this scan and the next one's preprocessing.
       // Joined before anything reads the map (StartOverlappedStages' task, or RunScan).
-      estimator_->MapPoints(scan, &pending_map_points_);
-      pending_map_position_ = estimator_->NewestPose().translation();
       StartMapInsertion();
     } else {
-      estimator_->MapPoints(scan, &map_points_);
-      frontend_.UpdateMap(map_points_, estimator_->NewestPose().translation());
+      frontend_.UpdateMap(map_points_, map_position_);
     }
   }
   if (registered.degenerate) ReportDegenerate(result);
@@ -489,24 +488,24 @@ SE3 LioOdometry::CurrentExtrinsic() const {
 void LioOdometry::StartMapInsertion() {
   map_insertion_ = std::async(std::launch::async, [this] {
     const auto t0 = std::chrono::steady_clock::now();
-    frontend_.UpdateMap(pending_map_points_, pending_map_position_);
-    pending_map_points_.clear();
+    frontend_.UpdateMap(map_points_, map_position_);
     return MsSince(t0);
   });
 }
 
 std::future<std::pair<double, double>> LioOdometry::StartOverlappedStages() {
   slid_ = false;
-  if (!config_.overlap_stages || (!map_insertion_.valid() && !initialised_)) return {};
+  // Before the first Process nothing is inserted (Initialise inserts on the scan thread) and
+  // nothing slides.
+  if (!config_.overlap_stages || !initialised_) return {};
   // Process slides first thing (Initialise does not): done here beside the preprocessing, which
   // reads neither the map nor the window (its extrinsic was read before), after the previous
   // scan's map insertion on the same second thread (waited for there, not here).
-  const bool slide = initialised_;
-  slid_ = slide;
+  slid_ = true;
   std::future<double> insertion = std::move(map_insertion_);
-  return std::async(std::launch::async, [this, slide, insertion = std::move(insertion)]() mutable {
+  return std::async(std::launch::async, [this, insertion = std::move(insertion)]() mutable {
     const double ms_map = insertion.valid() ? insertion.get() : 0.0;
-    return std::make_pair(ms_map, slide ? SlideWindow() : 0.0);
+    return std::make_pair(ms_map, SlideWindow());
   });
 }
 

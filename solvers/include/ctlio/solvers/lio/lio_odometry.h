@@ -102,7 +102,7 @@ class LioOdometry {
   // marginalisation, on a second thread; returns their wall ms (map, marginalise), or no future
   // without the overlap.
   std::future<std::pair<double, double>> StartOverlappedStages();
-  // config.overlap_stages: inserts pending_map_points_ into the map on a second thread, started
+  // config.overlap_stages: inserts map_points_ into the map on a second thread, started
   // as soon as the scan's pose is estimated (map_insertion_ returns its wall ms).
   void StartMapInsertion();
   // First scan: gravity initialisation (with an IMU), the first state, the map.
@@ -174,13 +174,14 @@ class LioOdometry {
   std::unique_ptr<CalibrationObservability> observability_;
   std::vector<ceres::ResidualBlockId> holds_;
   int num_marginalizations_ = 0;
-  // config.overlap_stages: the points the second thread inserts (StartMapInsertion), and whether
-  // this scan's marginalisation is done (overlapped with its preprocessing).
-  std::vector<Vec3> pending_map_points_;
-  Vec3 pending_map_position_ = Vec3::Zero();
+  PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused
+  // Its points in the map frame (MapPoints) and the robot position they are inserted at: on the
+  // scan thread, or with config.overlap_stages on the second one (StartMapInsertion).
+  std::vector<Vec3> map_points_;
+  Vec3 map_position_ = Vec3::Zero();
+  // config.overlap_stages: whether this scan's marginalisation is done (overlapped with its
+  // preprocessing).
   bool slid_ = false;
-  PreparedScan prepared_;         // the scan being processed (PrepareScan)
-  std::vector<Vec3> map_points_;  // its points in the map frame (MapPoints), reused
   // Warm-up replay (calibration.warmup_replay_s): every IMU sample and scan of the span as given
   // (each scan with the number of samples added before it), the pipeline that replayed them
   // (every call is forwarded to it from then on), and the live results it replaced.
