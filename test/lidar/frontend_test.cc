@@ -368,6 +368,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.max_iterations, 10);
   EXPECT_EQ(o.solver_iterations, d.solver_iterations);
   EXPECT_EQ(o.point_noise_sigma, 0.03);
+  EXPECT_EQ(o.residual_blocks, "interval");
+  EXPECT_EQ(o.residual_blocks, d.residual_blocks);
   EXPECT_EQ(o.loss, d.loss);
   EXPECT_EQ(o.loss_scale, d.loss_scale);
   EXPECT_EQ(o.convergence_translation, d.convergence_translation);
@@ -399,6 +401,9 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_NE(ErrorOf("point_noise_sigma: 0\n").find("point_noise_sigma"), std::string::npos);
   EXPECT_NE(ErrorOf("loss: tukey\n").find("loss"), std::string::npos);
   EXPECT_NE(ErrorOf("association: kdtree\n").find("association"), std::string::npos);
+  EXPECT_NE(ErrorOf("residual_blocks: scan\n").find("residual_blocks"), std::string::npos);
+  EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("residual_blocks: point\n")).residual_blocks,
+            "point");
   EXPECT_NE(ErrorOf("threads: 0\n").find("threads"), std::string::npos);
   EXPECT_NE(ErrorOf("reassociation_distance: -0.1\n").find("reassociation_distance"),
             std::string::npos);

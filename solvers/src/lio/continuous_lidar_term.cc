@@ -6,6 +6,7 @@
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
 #include "ctlio/manifolds/pose_manifold.h"
 
@@ -92,6 +93,29 @@ void ContinuousLidarTerm::UpdateResidual(size_t i, const PlaneAssociation& assoc
     static_cast<ContinuousPointToPlaneExtrinsic*>(costs_[i])->set_association(association);
   } else {
     static_cast<ContinuousPointToPlane*>(costs_[i])->set_association(association);
+  }
+}
+
+void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associated,
+                                            const std::vector<PlaneAssociation>& planes,
+                                            const std::shared_ptr<const ceres::LossFunction>& loss,
+                                            SlidingWindow* window,
+                                            std::vector<ceres::ResidualBlockId>* blocks) {
+  if (!batched()) throw std::logic_error("ContinuousLidarTerm::SetBatchResiduals: not batched");
+  for (ceres::ResidualBlockId id : *blocks) window->RemoveResidualBlock(id);
+  blocks->clear();
+  // Per interval, its keypoints in keypoint order.
+  std::vector<std::vector<ContinuousPointToPlaneBatch::Point>> points(states_.size());
+  for (size_t i = 0; i < keypoints_.size(); ++i) {
+    if (!associated[i]) continue;
+    const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
+    firing->set_active(true);  // a residual reads it in this round's solve
+    points[static_cast<size_t>(interval_of(i))].push_back({firing, planes[i]});
+  }
+  for (size_t j = 0; j < points.size(); ++j) {
+    if (points[j].empty()) continue;
+    blocks->push_back(window->AddResidualBlock(
+        new ContinuousPointToPlaneBatch(std::move(points[j]), loss), nullptr, states_[j]));
   }
 }
 

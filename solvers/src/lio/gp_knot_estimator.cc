@@ -326,7 +326,9 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
     return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, scan.T_robot_lidar,
                                                  window);
   }
-  return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
+  auto term = std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
+  term->set_batched(config_.frontend.residual_blocks == "interval");
+  return term;
 }
 
 void GpKnotEstimator::MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const {

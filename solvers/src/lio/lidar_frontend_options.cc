@@ -39,6 +39,8 @@ void LidarFrontendOptions::Validate() const {
   require(solver_iterations <= 1000, "solver_iterations must be <= 1000 per round");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
+  require(residual_blocks == "point" || residual_blocks == "interval",
+          "residual_blocks must be point or interval");
   require(point_noise_sigma > 0.0, "point_noise_sigma must be positive");
   require(loss_scale > 0.0, "loss_scale must be positive");
   require(convergence_translation >= 0.0 && convergence_rotation >= 0.0,
@@ -77,6 +79,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},
       {"loss", SetFromYaml(&o.loss)},
       {"loss_scale", SetFromYaml(&o.loss_scale)},
+      {"residual_blocks", SetFromYaml(&o.residual_blocks)},
       {"convergence_translation", SetFromYaml(&o.convergence_translation)},
       {"convergence_rotation", SetFromYaml(&o.convergence_rotation)},
       {"reassociation_distance", SetFromYaml(&o.reassociation_distance)},

@@ -1,6 +1,7 @@
 #include "ctlio/solvers/lio/scan_registration.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <vector>
 
 #include "ctlio/solvers/lio/frontend.h"
@@ -26,6 +27,14 @@ ScanRegistration::ScanRegistration(const LidarFrontendOptions& options, int min_
   options_.Validate();
 }
 
+void LidarTerm::SetBatchResiduals(const std::vector<uint8_t>& /*associated*/,
+                                  const std::vector<PlaneAssociation>& /*planes*/,
+                                  const std::shared_ptr<const ceres::LossFunction>& /*loss*/,
+                                  SlidingWindow* /*window*/,
+                                  std::vector<ceres::ResidualBlockId>* /*blocks*/) {
+  throw std::logic_error("LidarTerm::SetBatchResiduals: this lidar term has no batched residuals");
+}
+
 RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* term,
                                                SlidingWindow* window) const {
   using Clock = std::chrono::steady_clock;
@@ -45,7 +54,19 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
   std::vector<Vec3> searched_at(n);
   // Per keypoint: its residual in the window (nullptr: none).
   std::vector<ceres::ResidualBlockId> block(n, nullptr);
+  // Batched terms: one robust loss for the whole registration (the term's blocks share it),
+  // this round's whitened planes, and the term's blocks in the window.
+  const bool batched = term->batched();
+  const std::shared_ptr<const ceres::LossFunction> batch_loss =
+      batched ? std::shared_ptr<const ceres::LossFunction>(MakeLidarLoss(options_)) : nullptr;
+  std::vector<PlaneAssociation> whitened(batched ? n : 0);
+  std::vector<ceres::ResidualBlockId> batch_blocks;
   auto remove_all = [&] {
+    if (batched) {
+      term->SetBatchResiduals(std::vector<uint8_t>(n, 0), whitened, batch_loss, window,
+                              &batch_blocks);
+      return;
+    }
     for (ceres::ResidualBlockId& id : block) {
       if (id != nullptr) window->RemoveResidualBlock(id);
       id = nullptr;
@@ -77,10 +98,19 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
     // on that plane), one that lost its plane loses its block, a new one gets a block.
     // One loss for the new blocks of the round, shared by them; once a residual uses it the
     // window owns it (ref-counted by Ceres, deleted with the last such residual).
-    std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
+    std::unique_ptr<ceres::LossFunction> loss = batched ? nullptr : MakeLidarLoss(options_);
     bool loss_used = false;
     int associations = 0;
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; batched && i < n; ++i) {
+      if (!associated[i]) continue;
+      whitened[i] = planes[i];
+      whitened[i].weight /= options_.point_noise_sigma;
+      ++associations;
+    }
+    if (batched && associations >= min_associations_) {
+      term->SetBatchResiduals(associated, whitened, batch_loss, window, &batch_blocks);
+    }
+    for (size_t i = 0; !batched && i < n; ++i) {
       if (!associated[i]) {
         if (block[i] != nullptr) window->RemoveResidualBlock(block[i]);
         block[i] = nullptr;
@@ -123,6 +153,10 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
       summary.converged = true;
       break;
     }
+  }
+  if (batched) {
+    summary.lidar_blocks = batch_blocks;
+    return summary;
   }
   for (ceres::ResidualBlockId id : block) {
     if (id != nullptr) summary.lidar_blocks.push_back(id);

@@ -59,6 +59,17 @@ class ContinuousLidarTerm final : public LidarTerm {
   void UpdateResidual(size_t i, const PlaneAssociation& association) override;
   SE3 NewestPose() const override;  // T_rm of the last knot
 
+  // With `batched` (LidarFrontendOptions::residual_blocks "interval") the keypoints of each knot
+  // interval form one ContinuousPointToPlaneBatch block instead of one block each. Not with the
+  // extrinsic estimated (its residuals stay per keypoint): batched() is then false.
+  void set_batched(bool batched) { batched_ = batched; }
+  bool batched() const override { return batched_ && extrinsic_ == nullptr; }
+  void SetBatchResiduals(const std::vector<uint8_t>& associated,
+                         const std::vector<PlaneAssociation>& planes,
+                         const std::shared_ptr<const ceres::LossFunction>& loss,
+                         SlidingWindow* window,
+                         std::vector<ceres::ResidualBlockId>* blocks) override;
+
   int num_firings() const { return static_cast<int>(firings_.size()); }
   // The interval (0 = between the first two knots) keypoint i is a measurement on.
   int interval_of(size_t i) const { return interval_[static_cast<size_t>(firing_[i])]; }
@@ -84,6 +95,7 @@ class ContinuousLidarTerm final : public LidarTerm {
   std::vector<Vec3> points_lidar_;
   const double* extrinsic_ = nullptr;
   SE3 T_rl_;
+  bool batched_ = false;
 };
 
 }  // namespace ctlio::lio

@@ -21,6 +21,7 @@
 
 #include <ceres/loss_function.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -52,6 +53,20 @@ class LidarTerm {
   virtual void UpdateResidual(size_t i, const PlaneAssociation& association) = 0;
   // The pose whose change between rounds decides convergence (the newest state's).
   virtual SE3 NewestPose() const = 0;
+
+  // Batched residuals (LidarFrontendOptions::residual_blocks "interval"): when true, the
+  // registration gives each round's associations to SetBatchResiduals instead of AddResidual /
+  // UpdateResidual per keypoint.
+  virtual bool batched() const { return false; }
+  // Replaces the residuals of the previous round (if any) by those of this round: keypoint i with
+  // associated[i] != 0 measures planes[i] (weight already whitened) with the robust loss `loss`
+  // (nullable) applied per keypoint. No associated keypoint: the lidar residuals are removed.
+  // Writes the residual blocks now in the window into *blocks. Only called when batched().
+  virtual void SetBatchResiduals(const std::vector<uint8_t>& associated,
+                                 const std::vector<PlaneAssociation>& planes,
+                                 const std::shared_ptr<const ceres::LossFunction>& loss,
+                                 SlidingWindow* window,
+                                 std::vector<ceres::ResidualBlockId>* blocks);
 };
 
 struct RegistrationSummary {
@@ -64,7 +79,8 @@ struct RegistrationSummary {
   bool degenerate = false;    // too few associations: the lidar term was dropped
   double ms_associate = 0.0;  // wall time of the association, all rounds
   double ms_solve = 0.0;      // wall time of the solves, all rounds
-  // The last round's residuals (in the window), in keypoint order.
+  // The last round's residuals (in the window): one per keypoint, in keypoint order, or with a
+  // batched term one per knot interval.
   std::vector<ceres::ResidualBlockId> lidar_blocks;
 };
 

@@ -1,0 +1,117 @@
+// The continuous-time point-to-plane residuals of all keypoints on one knot interval as ONE
+// residual block (SPEC §4): row i is keypoint i's ContinuousPointToPlane residual, evaluated by
+// the same code (ContinuousPointToPlane::EvaluateAtKnots, the one GP interpolation), with its
+// robust loss applied inside the block. Still one residual per point (SPEC §4: points are not
+// summed before squaring); what is batched is Ceres' per-block machinery — the evaluation call,
+// the invalidation and validity check, the loss correction and the manifold product, ~2/3 of the
+// instructions of a per-point block's evaluation (README "LIO latency") — which runs once per
+// interval instead of once per keypoint.
+//
+// Why the loss goes inside, and how: Ceres robustifies a residual BLOCK by ρ(‖r‖²), so a block
+// of N points with a Ceres loss would be one robust term, not N. The block therefore applies
+// each row's loss itself, exactly as Ceres' Corrector would to a one-point block (Triggs et al.,
+// "Bundle adjustment — a modern synthesis", §4.3, in the form Ceres uses for ρ'' ≤ 0, which holds
+// for Cauchy, Huber, SoftL1 and Arctan): row i is √ρ'(e_i²)·e_i with Jacobian √ρ'(e_i²)·∂e_i.
+// Those rows carry the gradient Σρ'e_i∂e_i and the Gauss–Newton Hessian Σρ'∂e_iᵀ∂e_i of N
+// per-point blocks, but their squares sum to Σρ'e_i², not to the robust cost Σρ(e_i²); one more
+// row, constant (zero Jacobian), holds the difference,
+//
+//   r_N = √(Σ_i ρ(e_i²) − ρ'(e_i²)·e_i²)   (≥ 0: a concave ρ with ρ(0) = 0 has ρ(s) ≥ ρ'(s)·s),
+//
+// so ½‖r‖² is the robust cost Ceres would report. Cost, gradient and Gauss–Newton Hessian — the
+// whole Levenberg–Marquardt step and its acceptance test — and the marginalisation's
+// linearisation (SlidingWindow::Linearize, which applies no loss to this block) are those of the
+// per-point blocks up to rounding (test lidar.ContinuousPointToPlaneBatch.*). As with Ceres'
+// corrected Jacobian, the rows' Jacobian is the Gauss–Newton one, not the derivative of the
+// scaled rows: without a loss there is no extra row and the block is an ordinary cost function
+// (its Jacobians are checked numerically). A loss with ρ'' > 0 somewhere (convex, e.g. Tolerant)
+// has no such constant row: Evaluate returns false there.
+//
+// Parameter blocks: pose_k (7, PoseManifold), ϖ_k (6), ϖ̇_k (6), pose_k+1, ϖ_k+1, ϖ̇_k+1 — those of
+// every point's interpolation (each SharedPoseInterpolation must interpolate on this interval).
+#pragma once
+
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "ctlio/factors/lidar/continuous_point_to_plane.h"
+
+namespace ctlio {
+
+class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
+ public:
+  struct Point {
+    std::shared_ptr<const SharedPoseInterpolation> pose;  // at the point's τ, on this interval
+    PlaneAssociation association;
+  };
+
+  // At least one point. `loss` (nullable) is each point's robust loss; it is shared, not copied.
+  ContinuousPointToPlaneBatch(std::vector<Point> points,
+                              std::shared_ptr<const ceres::LossFunction> loss)
+      : points_(std::move(points)), loss_(std::move(loss)) {
+    if (points_.empty()) throw std::invalid_argument("ContinuousPointToPlaneBatch: no points");
+    set_num_residuals(static_cast<int>(points_.size()) + (loss_ != nullptr ? 1 : 0));
+    for (const int size : kBlockSizes) mutable_parameter_block_sizes()->push_back(size);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const size_t n = points_.size();
+    double* rows[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+    double cost_gap = 0.0;  // Σ ρ(e²) − ρ'(e²)·e²
+    for (size_t i = 0; i < n; ++i) {
+      bool any = false;
+      if (jacobians != nullptr) {
+        for (int b = 0; b < 6; ++b) {
+          rows[b] = jacobians[b] != nullptr ? jacobians[b] + i * kBlockSizes[b] : nullptr;
+          any = any || rows[b] != nullptr;
+        }
+      }
+      const Point& p = points_[i];
+      const double e = ContinuousPointToPlane::EvaluateAtKnots(*p.pose, p.association, parameters,
+                                                               any ? rows : nullptr, nullptr);
+      if (loss_ == nullptr) {
+        residuals[i] = e;
+        continue;
+      }
+      double rho[3];
+      loss_->Evaluate(e * e, rho);
+      if (rho[2] > 0.0) return false;  // not concave here: no exact constant row (above)
+      const double scale = std::sqrt(rho[1]);
+      residuals[i] = scale * e;
+      cost_gap += rho[0] - rho[1] * e * e;
+      if (!any) continue;
+      for (int b = 0; b < 6; ++b) {
+        if (rows[b] == nullptr) continue;
+        for (int c = 0; c < kBlockSizes[b]; ++c) rows[b][c] *= scale;
+      }
+    }
+    if (loss_ == nullptr) return true;
+    residuals[n] = std::sqrt(std::max(cost_gap, 0.0));  // clamps rounding below 0 only
+    if (jacobians != nullptr) {
+      for (int b = 0; b < 6; ++b) {
+        if (jacobians[b] != nullptr) std::fill_n(jacobians[b] + n * kBlockSizes[b], kBlockSizes[b], 0.0);
+      }
+    }
+    return true;
+  }
+
+  size_t size() const { return points_.size(); }
+  const Point& point(size_t i) const { return points_[i]; }
+  const ceres::LossFunction* loss() const { return loss_.get(); }
+
+ private:
+  static constexpr int kBlockSizes[6] = {7, 6, 6, 7, 6, 6};
+
+  std::vector<Point> points_;
+  std::shared_ptr<const ceres::LossFunction> loss_;
+};
+
+}  // namespace ctlio

@@ -1,0 +1,202 @@
+// ContinuousPointToPlaneBatch (SPEC §4): without a loss, row i is keypoint i's
+// ContinuousPointToPlane residual and the Jacobians match numeric differentiation (random,
+// large-rotation / |φ| near π and near-identity knots, points sharing a firing); with a Cauchy or
+// Huber loss, Ceres sees the cost, gradient and Gauss–Newton Hessian of N one-point blocks with
+// that loss (ceres::Problem::Evaluate of both problems); a convex loss fails the evaluation
+// instead of returning a wrong cost.
+#include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
+
+#include <ceres/crs_matrix.h>
+#include <ceres/problem.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "common/gradient_check.h"
+#include "lidar/random_association.h"
+
+namespace ctlio {
+namespace {
+
+using testing::JacobiansMatchNumeric;
+using testing::PoseParameters;
+using testing::RandomAssociation;
+using testing::RandomPose;
+using testing::RandomVec6;
+
+gp::SingerModel<6> Model() {
+  Vec6 qc, alpha;
+  qc << 5000, 5000, 5000, 500, 500, 500;
+  alpha << 0, 0, 0, 100, 100, 100;
+  return gp::SingerModel<6>(qc, alpha);
+}
+
+struct Knots {
+  std::vector<double> pose_k, pose_k1;
+  Vec6 w_k, dw_k, w_k1, dw_k1;
+  std::vector<const double*> Params() const {
+    return {pose_k.data(), w_k.data(), dw_k.data(), pose_k1.data(), w_k1.data(), dw_k1.data()};
+  }
+};
+
+// kind 0: random; 1: knot k rotated by nearly π, a large motion to k+1; 2: near identity.
+Knots KnotsOfKind(std::mt19937& rng, int kind) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double angle = kind == 2 ? 1e-7 : M_PI, step = kind == 0 ? 0.5 : (kind == 1 ? 2.5 : 1e-7);
+  const double velocity = kind == 0 ? 2.0 : (kind == 1 ? 10.0 : 1e-7);
+  SE3 T_k = RandomPose(rng, angle, 10.0);
+  if (kind == 1) {
+    T_k = SE3(so3::Exp((M_PI - 1e-6) * Vec3(u(rng), u(rng), u(rng)).normalized()),
+              Vec3(1.0, 2.0, 3.0));
+  }
+  Knots s;
+  s.pose_k = PoseParameters(T_k);
+  s.pose_k1 = PoseParameters(RandomPose(rng, step, step) * T_k);
+  s.w_k = RandomVec6(rng, velocity);
+  s.dw_k = RandomVec6(rng, 5.0 * velocity);
+  s.w_k1 = RandomVec6(rng, velocity);
+  s.dw_k1 = RandomVec6(rng, 5.0 * velocity);
+  return s;
+}
+
+// n points on [0, 0.1] s, the last two on one firing (one shared interpolation).
+std::vector<ContinuousPointToPlaneBatch::Point> RandomPoints(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto model = Model();
+  std::vector<ContinuousPointToPlaneBatch::Point> points;
+  std::shared_ptr<const SharedPoseInterpolation> firing;
+  for (int i = 0; i < n; ++i) {
+    if (i < n - 1) {
+      const double tau = i == 0 ? 0.0 : (i == 1 ? 0.1 : 0.1 * u(rng));
+      firing = std::make_shared<const SharedPoseInterpolation>(
+          std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, tau));
+    }
+    points.push_back({firing, RandomAssociation(rng)});
+  }
+  return points;
+}
+
+TEST(ContinuousPointToPlaneBatch, RowsAreThePerPointResidualsWithoutLoss) {
+  std::mt19937 rng(51);
+  const auto points = RandomPoints(rng, 6);
+  const ContinuousPointToPlaneBatch batch(points, nullptr);
+  ASSERT_EQ(batch.num_residuals(), 6);
+  const Knots s = KnotsOfKind(rng, 0);
+  std::vector<double> r(6);
+  ASSERT_TRUE(batch.Evaluate(s.Params().data(), r.data(), nullptr));
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ContinuousPointToPlane single(points[i].pose, points[i].association);
+    double e = 0.0;
+    ASSERT_TRUE(single.Evaluate(s.Params().data(), &e, nullptr));
+    EXPECT_EQ(r[i], e) << i;
+  }
+}
+
+TEST(ContinuousPointToPlaneBatch, JacobiansWithoutLossMatchNumeric) {
+  std::mt19937 rng(52);
+  const PoseManifold pose;
+  const std::vector<const ceres::Manifold*> manifolds = {&pose,    nullptr, nullptr,
+                                                         &pose,    nullptr, nullptr};
+  for (int trial = 0; trial < 9; ++trial) {
+    const int kind = trial % 3;
+    const ContinuousPointToPlaneBatch batch(RandomPoints(rng, 5), nullptr);
+    EXPECT_TRUE(JacobiansMatchNumeric(batch, manifolds, KnotsOfKind(rng, kind).Params()))
+        << "kind " << kind << " trial " << trial;
+  }
+}
+
+// The two problems Ceres would solve: N one-point blocks with the loss, and the batch.
+struct Evaluated {
+  double cost = 0.0;
+  std::vector<double> gradient;
+  Eigen::MatrixXd JtJ;
+};
+
+Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs,
+                          ceres::LossFunction* loss, const Knots& at) {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(options);
+  Knots x = at;  // the problem's own blocks
+  const std::vector<double*> blocks = {x.pose_k.data(),  x.w_k.data(),  x.dw_k.data(),
+                                       x.pose_k1.data(), x.w_k1.data(), x.dw_k1.data()};
+  for (ceres::CostFunction* cost : costs) problem.AddResidualBlock(cost, loss, blocks);
+  PoseManifold pose;
+  problem.SetManifold(x.pose_k.data(), &pose);
+  problem.SetManifold(x.pose_k1.data(), &pose);
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = blocks;
+  Evaluated out;
+  ceres::CRSMatrix J;
+  EXPECT_TRUE(problem.Evaluate(eval, &out.cost, nullptr, &out.gradient, &J));
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(J.num_rows, J.num_cols);
+  for (int row = 0; row < J.num_rows; ++row) {
+    for (int k = J.rows[row]; k < J.rows[row + 1]; ++k) dense(row, J.cols[k]) = J.values[k];
+  }
+  out.JtJ = dense.transpose() * dense;
+  return out;
+}
+
+void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
+  std::mt19937 rng(seed);
+  for (int kind = 0; kind < 3; ++kind) {
+    const auto points = RandomPoints(rng, 12);
+    const Knots at = KnotsOfKind(rng, kind);
+    std::vector<std::unique_ptr<ceres::CostFunction>> owned;
+    std::vector<ceres::CostFunction*> singles;
+    for (const auto& p : points) {
+      owned.push_back(std::make_unique<ContinuousPointToPlane>(p.pose, p.association));
+      singles.push_back(owned.back().get());
+    }
+    // The batch shares the loss without owning it (the problem above does not own it either).
+    ContinuousPointToPlaneBatch batch(points, std::shared_ptr<const ceres::LossFunction>(
+                                                  loss, [](const ceres::LossFunction*) {}));
+    ASSERT_EQ(batch.num_residuals(), 13);  // one row per point and the constant row
+    const Evaluated a = EvaluateProblem(singles, loss, at);
+    const Evaluated b = EvaluateProblem({&batch}, nullptr, at);
+    EXPECT_NEAR(b.cost, a.cost, 1e-12 * a.cost) << "kind " << kind;
+    ASSERT_EQ(a.gradient.size(), b.gradient.size());
+    const double g_scale = Eigen::Map<const Eigen::VectorXd>(a.gradient.data(),
+                                                             static_cast<Eigen::Index>(
+                                                                 a.gradient.size()))
+                               .cwiseAbs()
+                               .maxCoeff();
+    for (size_t i = 0; i < a.gradient.size(); ++i) {
+      EXPECT_NEAR(b.gradient[i], a.gradient[i], 1e-12 * g_scale) << "kind " << kind << " " << i;
+    }
+    EXPECT_LE((b.JtJ - a.JtJ).cwiseAbs().maxCoeff(), 1e-12 * a.JtJ.cwiseAbs().maxCoeff())
+        << "kind " << kind;
+  }
+}
+
+// The random planes give residuals of a few metres up to ~40 m (weights 0.1–1): scale 2 puts
+// some points inside the loss's quadratic part and most far outside it.
+TEST(ContinuousPointToPlaneBatch, CauchyGivesCeresPerPointCostGradientAndHessian) {
+  ceres::CauchyLoss loss(2.0);
+  ExpectSameLinearModel(&loss, 53);
+}
+
+TEST(ContinuousPointToPlaneBatch, HuberGivesCeresPerPointCostGradientAndHessian) {
+  ceres::HuberLoss loss(2.0);
+  ExpectSameLinearModel(&loss, 54);
+}
+
+TEST(ContinuousPointToPlaneBatch, ConvexLossFailsTheEvaluation) {
+  std::mt19937 rng(55);
+  const ContinuousPointToPlaneBatch batch(RandomPoints(rng, 3),
+                                          std::make_shared<const ceres::TolerantLoss>(1.0, 0.5));
+  const Knots s = KnotsOfKind(rng, 0);
+  std::vector<double> r(4);
+  EXPECT_FALSE(batch.Evaluate(s.Params().data(), r.data(), nullptr));
+}
+
+TEST(ContinuousPointToPlaneBatch, NoPointsIsAnError) {
+  EXPECT_THROW(ContinuousPointToPlaneBatch({}, nullptr), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ctlio
