@@ -1,10 +1,13 @@
 // ContinuousPointToPlaneBatch (SPEC §4): without a loss, row i is keypoint i's
-// ContinuousPointToPlane residual and the Jacobians match numeric differentiation (random,
-// large-rotation / |φ| near π and near-identity knots, points sharing a firing); with a Cauchy or
-// Huber loss, Ceres sees the cost, gradient and Gauss–Newton Hessian of N one-point blocks with
-// that loss (ceres::Problem::Evaluate of both problems); a convex loss fails the evaluation
-// instead of returning a wrong cost.
+// ContinuousPointToPlane (with the extrinsic: ContinuousPointToPlaneExtrinsic) residual and the
+// Jacobians match numeric differentiation (random, large-rotation / |φ| near π and near-identity
+// knots and extrinsics, points sharing a firing); with a Cauchy or Huber loss, Ceres sees the
+// cost, gradient and Gauss–Newton Hessian of N one-point blocks with that loss
+// (ceres::Problem::Evaluate of both problems); a convex loss fails the evaluation instead of
+// returning a wrong cost.
 #include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
+
+#include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
 
 #include <ceres/crs_matrix.h>
 #include <ceres/problem.h>
@@ -33,11 +36,15 @@ gp::SingerModel<6> Model() {
   return gp::SingerModel<6>(qc, alpha);
 }
 
+// The knot blocks and, for the extrinsic form, T_rl.
 struct Knots {
-  std::vector<double> pose_k, pose_k1;
+  std::vector<double> pose_k, pose_k1, extrinsic;
   Vec6 w_k, dw_k, w_k1, dw_k1;
   std::vector<const double*> Params() const {
-    return {pose_k.data(), w_k.data(), dw_k.data(), pose_k1.data(), w_k1.data(), dw_k1.data()};
+    std::vector<const double*> p = {pose_k.data(),  w_k.data(),  dw_k.data(),
+                                    pose_k1.data(), w_k1.data(), dw_k1.data()};
+    if (!extrinsic.empty()) p.push_back(extrinsic.data());
+    return p;
   }
 };
 
@@ -58,6 +65,12 @@ Knots KnotsOfKind(std::mt19937& rng, int kind) {
   s.dw_k = RandomVec6(rng, 5.0 * velocity);
   s.w_k1 = RandomVec6(rng, velocity);
   s.dw_k1 = RandomVec6(rng, 5.0 * velocity);
+  s.extrinsic = PoseParameters(RandomPose(rng, kind == 2 ? 1e-7 : M_PI, 0.5));
+  return s;
+}
+
+Knots WithoutExtrinsic(Knots s) {
+  s.extrinsic.clear();
   return s;
 }
 
@@ -73,7 +86,8 @@ std::vector<ContinuousPointToPlaneBatch::Point> RandomPoints(std::mt19937& rng, 
       firing = std::make_shared<const SharedPoseInterpolation>(
           std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, tau));
     }
-    points.push_back({firing, RandomAssociation(rng)});
+    const PlaneAssociation m = RandomAssociation(rng);
+    points.push_back({firing, m, 0.5 * m.point_robot + Vec3(0.3, -0.2, 0.1)});
   }
   return points;
 }
@@ -85,12 +99,20 @@ TEST(ContinuousPointToPlaneBatch, RowsAreThePerPointResidualsWithoutLoss) {
   ASSERT_EQ(batch.num_residuals(), 6);
   const Knots s = KnotsOfKind(rng, 0);
   std::vector<double> r(6);
-  ASSERT_TRUE(batch.Evaluate(s.Params().data(), r.data(), nullptr));
+  ASSERT_TRUE(batch.Evaluate(WithoutExtrinsic(s).Params().data(), r.data(), nullptr));
+  const ContinuousPointToPlaneBatch with_extrinsic(points, nullptr, /*with_extrinsic=*/true);
+  ASSERT_EQ(with_extrinsic.parameter_block_sizes().size(), 7u);
+  std::vector<double> r_rl(6);
+  ASSERT_TRUE(with_extrinsic.Evaluate(s.Params().data(), r_rl.data(), nullptr));
   for (size_t i = 0; i < points.size(); ++i) {
     const ContinuousPointToPlane single(points[i].pose, points[i].association);
     double e = 0.0;
     ASSERT_TRUE(single.Evaluate(s.Params().data(), &e, nullptr));
     EXPECT_EQ(r[i], e) << i;
+    const ContinuousPointToPlaneExtrinsic single_rl(points[i].pose, points[i].association,
+                                                    points[i].point_lidar);
+    ASSERT_TRUE(single_rl.Evaluate(s.Params().data(), &e, nullptr));
+    EXPECT_EQ(r_rl[i], e) << i;
   }
 }
 
@@ -99,11 +121,18 @@ TEST(ContinuousPointToPlaneBatch, JacobiansWithoutLossMatchNumeric) {
   const PoseManifold pose;
   const std::vector<const ceres::Manifold*> manifolds = {&pose,    nullptr, nullptr,
                                                          &pose,    nullptr, nullptr};
+  const std::vector<const ceres::Manifold*> manifolds_rl = {&pose, nullptr, nullptr, &pose,
+                                                            nullptr, nullptr, &pose};
   for (int trial = 0; trial < 9; ++trial) {
     const int kind = trial % 3;
-    const ContinuousPointToPlaneBatch batch(RandomPoints(rng, 5), nullptr);
-    EXPECT_TRUE(JacobiansMatchNumeric(batch, manifolds, KnotsOfKind(rng, kind).Params()))
+    const auto points = RandomPoints(rng, 5);
+    const Knots at = KnotsOfKind(rng, kind);
+    const ContinuousPointToPlaneBatch batch(points, nullptr);
+    EXPECT_TRUE(JacobiansMatchNumeric(batch, manifolds, WithoutExtrinsic(at).Params()))
         << "kind " << kind << " trial " << trial;
+    const ContinuousPointToPlaneBatch with_extrinsic(points, nullptr, /*with_extrinsic=*/true);
+    EXPECT_TRUE(JacobiansMatchNumeric(with_extrinsic, manifolds_rl, at.Params()))
+        << "with the extrinsic, kind " << kind << " trial " << trial;
   }
 }
 
@@ -122,12 +151,14 @@ Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs,
   options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(options);
   Knots x = at;  // the problem's own blocks
-  const std::vector<double*> blocks = {x.pose_k.data(),  x.w_k.data(),  x.dw_k.data(),
-                                       x.pose_k1.data(), x.w_k1.data(), x.dw_k1.data()};
+  std::vector<double*> blocks = {x.pose_k.data(),  x.w_k.data(),  x.dw_k.data(),
+                                 x.pose_k1.data(), x.w_k1.data(), x.dw_k1.data()};
+  if (!x.extrinsic.empty()) blocks.push_back(x.extrinsic.data());
   for (ceres::CostFunction* cost : costs) problem.AddResidualBlock(cost, loss, blocks);
   PoseManifold pose;
   problem.SetManifold(x.pose_k.data(), &pose);
   problem.SetManifold(x.pose_k1.data(), &pose);
+  if (!x.extrinsic.empty()) problem.SetManifold(x.extrinsic.data(), &pose);
   ceres::Problem::EvaluateOptions eval;
   eval.parameter_blocks = blocks;
   Evaluated out;
@@ -143,22 +174,30 @@ Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs,
 
 void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
   std::mt19937 rng(seed);
-  for (int kind = 0; kind < 3; ++kind) {
+  for (int trial = 0; trial < 6; ++trial) {
+    const int kind = trial % 3;
+    const bool extrinsic = trial >= 3;
     const auto points = RandomPoints(rng, 12);
-    const Knots at = KnotsOfKind(rng, kind);
+    const Knots at = extrinsic ? KnotsOfKind(rng, kind) : WithoutExtrinsic(KnotsOfKind(rng, kind));
     std::vector<std::unique_ptr<ceres::CostFunction>> owned;
     std::vector<ceres::CostFunction*> singles;
     for (const auto& p : points) {
-      owned.push_back(std::make_unique<ContinuousPointToPlane>(p.pose, p.association));
+      if (extrinsic) {
+        owned.push_back(
+            std::make_unique<ContinuousPointToPlaneExtrinsic>(p.pose, p.association, p.point_lidar));
+      } else {
+        owned.push_back(std::make_unique<ContinuousPointToPlane>(p.pose, p.association));
+      }
       singles.push_back(owned.back().get());
     }
     // The batch shares the loss without owning it (the problem above does not own it either).
-    ContinuousPointToPlaneBatch batch(points, std::shared_ptr<const ceres::LossFunction>(
-                                                  loss, [](const ceres::LossFunction*) {}));
+    ContinuousPointToPlaneBatch batch(
+        points, std::shared_ptr<const ceres::LossFunction>(loss, [](const ceres::LossFunction*) {}),
+        extrinsic);
     ASSERT_EQ(batch.num_residuals(), 13);  // one row per point and the constant row
     const Evaluated a = EvaluateProblem(singles, loss, at);
     const Evaluated b = EvaluateProblem({&batch}, nullptr, at);
-    EXPECT_NEAR(b.cost, a.cost, 1e-12 * a.cost) << "kind " << kind;
+    EXPECT_NEAR(b.cost, a.cost, 1e-12 * a.cost) << "trial " << trial;
     ASSERT_EQ(a.gradient.size(), b.gradient.size());
     const double g_scale = Eigen::Map<const Eigen::VectorXd>(a.gradient.data(),
                                                              static_cast<Eigen::Index>(
@@ -166,10 +205,10 @@ void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
                                .cwiseAbs()
                                .maxCoeff();
     for (size_t i = 0; i < a.gradient.size(); ++i) {
-      EXPECT_NEAR(b.gradient[i], a.gradient[i], 1e-12 * g_scale) << "kind " << kind << " " << i;
+      EXPECT_NEAR(b.gradient[i], a.gradient[i], 1e-12 * g_scale) << "trial " << trial << " " << i;
     }
     EXPECT_LE((b.JtJ - a.JtJ).cwiseAbs().maxCoeff(), 1e-12 * a.JtJ.cwiseAbs().maxCoeff())
-        << "kind " << kind;
+        << "trial " << trial;
   }
 }
 
@@ -189,7 +228,7 @@ TEST(ContinuousPointToPlaneBatch, ConvexLossFailsTheEvaluation) {
   std::mt19937 rng(55);
   const ContinuousPointToPlaneBatch batch(RandomPoints(rng, 3),
                                           std::make_shared<const ceres::TolerantLoss>(1.0, 0.5));
-  const Knots s = KnotsOfKind(rng, 0);
+  const Knots s = WithoutExtrinsic(KnotsOfKind(rng, 0));
   std::vector<double> r(4);
   EXPECT_FALSE(batch.Evaluate(s.Params().data(), r.data(), nullptr));
 }

@@ -322,11 +322,10 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
   for (size_t i = ScanStartIndex(); i < knots_.size(); ++i) {
     knots.push_back({knots_[i].t, knots_[i].keys});
   }
-  if (estimates_extrinsic()) {
-    return std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, scan.T_robot_lidar,
-                                                 window);
-  }
-  auto term = std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
+  auto term = estimates_extrinsic()
+                  ? std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints,
+                                                          scan.T_robot_lidar, window)
+                  : std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
   term->set_batched(config_.frontend.residual_blocks == "interval");
   return term;
 }

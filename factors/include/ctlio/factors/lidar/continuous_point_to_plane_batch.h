@@ -27,8 +27,12 @@
 // (its Jacobians are checked numerically). A loss with ρ'' > 0 somewhere (convex, e.g. Tolerant)
 // has no such constant row: Evaluate returns false there.
 //
+// With the extrinsic (online calibration) each row is instead the ContinuousPointToPlaneExtrinsic
+// residual of the point's lidar-frame coordinates, T_rl read once per evaluation.
+//
 // Parameter blocks: pose_k (7, PoseManifold), ϖ_k (6), ϖ̇_k (6), pose_k+1, ϖ_k+1, ϖ̇_k+1 — those of
-// every point's interpolation (each SharedPoseInterpolation must interpolate on this interval).
+// every point's interpolation (each SharedPoseInterpolation must interpolate on this interval) —
+// and, with the extrinsic, T_rl (7, PoseManifold).
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -42,6 +46,7 @@
 #include <vector>
 
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
+#include "ctlio/manifolds/pose_manifold.h"
 
 namespace ctlio {
 
@@ -49,34 +54,52 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
  public:
   struct Point {
     std::shared_ptr<const SharedPoseInterpolation> pose;  // at the point's τ, on this interval
-    PlaneAssociation association;
+    PlaneAssociation association;  // with the extrinsic its point_robot is not read
+    Vec3 point_lidar = Vec3::Zero();  // q_l, with the extrinsic only
   };
 
   // At least one point. `loss` (nullable) is each point's robust loss; it is shared, not copied.
+  // `with_extrinsic`: a seventh block T_rl, each point entering as T_rl·point_lidar.
   ContinuousPointToPlaneBatch(std::vector<Point> points,
-                              std::shared_ptr<const ceres::LossFunction> loss)
-      : points_(std::move(points)), loss_(std::move(loss)) {
+                              std::shared_ptr<const ceres::LossFunction> loss,
+                              bool with_extrinsic = false)
+      : points_(std::move(points)), loss_(std::move(loss)), blocks_(with_extrinsic ? 7 : 6) {
     if (points_.empty()) throw std::invalid_argument("ContinuousPointToPlaneBatch: no points");
     set_num_residuals(static_cast<int>(points_.size()) + (loss_ != nullptr ? 1 : 0));
-    for (const int size : kBlockSizes) mutable_parameter_block_sizes()->push_back(size);
+    for (int b = 0; b < blocks_; ++b) mutable_parameter_block_sizes()->push_back(kBlockSizes[b]);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const size_t n = points_.size();
-    double* rows[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+    const bool extrinsic = blocks_ == 7;
+    const SE3 T_rl = extrinsic ? PoseManifold::Pose(parameters[6]) : SE3();
+    double* rows[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
     double cost_gap = 0.0;  // Σ ρ(e²) − ρ'(e²)·e²
+    PlaneAssociation m;
+    Eigen::Matrix<double, 1, 6> J_tau;
     for (size_t i = 0; i < n; ++i) {
       bool any = false;
       if (jacobians != nullptr) {
-        for (int b = 0; b < 6; ++b) {
+        for (int b = 0; b < blocks_; ++b) {
           rows[b] = jacobians[b] != nullptr ? jacobians[b] + i * kBlockSizes[b] : nullptr;
           any = any || rows[b] != nullptr;
         }
       }
       const Point& p = points_[i];
-      const double e = ContinuousPointToPlane::EvaluateAtKnots(*p.pose, p.association, parameters,
-                                                               any ? rows : nullptr, nullptr);
+      const PlaneAssociation* association = &p.association;
+      if (extrinsic) {  // as ContinuousPointToPlaneExtrinsic: q = T_rl·q_l, de/dδ_rl = −de/dδT(τ)
+        m = p.association;
+        m.point_robot = T_rl * p.point_lidar;
+        association = &m;
+      }
+      const bool want_rl = extrinsic && rows[6] != nullptr;
+      const double e =
+          ContinuousPointToPlane::EvaluateAtKnots(*p.pose, *association, parameters,
+                                                  any ? rows : nullptr, want_rl ? &J_tau : nullptr);
+      if (want_rl) {
+        LiftPoseJacobian<1>(Eigen::Matrix<double, 1, 6>(-J_tau), parameters[6], rows[6]);
+      }
       if (loss_ == nullptr) {
         residuals[i] = e;
         continue;
@@ -88,7 +111,7 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
       residuals[i] = scale * e;
       cost_gap += rho[0] - rho[1] * e * e;
       if (!any) continue;
-      for (int b = 0; b < 6; ++b) {
+      for (int b = 0; b < blocks_; ++b) {
         if (rows[b] == nullptr) continue;
         for (int c = 0; c < kBlockSizes[b]; ++c) rows[b][c] *= scale;
       }
@@ -96,7 +119,7 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
     if (loss_ == nullptr) return true;
     residuals[n] = std::sqrt(std::max(cost_gap, 0.0));  // clamps rounding below 0 only
     if (jacobians != nullptr) {
-      for (int b = 0; b < 6; ++b) {
+      for (int b = 0; b < blocks_; ++b) {
         if (jacobians[b] != nullptr) std::fill_n(jacobians[b] + n * kBlockSizes[b], kBlockSizes[b], 0.0);
       }
     }
@@ -108,10 +131,11 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
   const ceres::LossFunction* loss() const { return loss_.get(); }
 
  private:
-  static constexpr int kBlockSizes[6] = {7, 6, 6, 7, 6, 6};
+  static constexpr int kBlockSizes[7] = {7, 6, 6, 7, 6, 6, 7};
 
   std::vector<Point> points_;
   std::shared_ptr<const ceres::LossFunction> loss_;
+  int blocks_;
 };
 
 }  // namespace ctlio

@@ -64,7 +64,7 @@ struct LidarFrontendOptions {
   std::string loss = "cauchy";      // "cauchy", "huber" or "none"
   double loss_scale = 0.1;  // metres, on the planarity-weighted residual w·nᵀ(p_ref − T_mr q)
   // Residual blocks of the continuous-time point-to-plane residuals (Singer-LIO, lidar_gyro,
-  // lidar_only without the extrinsic estimated; the IMU-as-input baseline keeps "point"):
+  // lidar_only; with the extrinsic estimated and in the IMU-as-input baseline always "point"):
   // "point": one Ceres residual block per keypoint with the loss as Ceres applies it;
   // "interval": the keypoints of one knot interval as one block (ContinuousPointToPlaneBatch),
   // still one residual and one robust loss per keypoint, applied inside the block as Ceres
