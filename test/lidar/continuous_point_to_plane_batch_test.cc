@@ -7,8 +7,6 @@
 // returning a wrong cost.
 #include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
 
-#include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
-
 #include <ceres/crs_matrix.h>
 #include <ceres/problem.h>
 #include <gtest/gtest.h>
@@ -18,6 +16,7 @@
 #include <vector>
 
 #include "common/gradient_check.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
 #include "lidar/random_association.h"
 
 namespace ctlio {
@@ -119,9 +118,9 @@ TEST(ContinuousPointToPlaneBatch, RowsAreThePerPointResidualsWithoutLoss) {
 TEST(ContinuousPointToPlaneBatch, JacobiansWithoutLossMatchNumeric) {
   std::mt19937 rng(52);
   const PoseManifold pose;
-  const std::vector<const ceres::Manifold*> manifolds = {&pose,    nullptr, nullptr,
-                                                         &pose,    nullptr, nullptr};
-  const std::vector<const ceres::Manifold*> manifolds_rl = {&pose, nullptr, nullptr, &pose,
+  const std::vector<const ceres::Manifold*> manifolds = {&pose, nullptr, nullptr,
+                                                         &pose, nullptr, nullptr};
+  const std::vector<const ceres::Manifold*> manifolds_rl = {&pose,   nullptr, nullptr, &pose,
                                                             nullptr, nullptr, &pose};
   for (int trial = 0; trial < 9; ++trial) {
     const int kind = trial % 3;
@@ -143,8 +142,8 @@ struct Evaluated {
   Eigen::MatrixXd JtJ;
 };
 
-Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs,
-                          ceres::LossFunction* loss, const Knots& at) {
+Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs, ceres::LossFunction* loss,
+                          const Knots& at) {
   ceres::Problem::Options options;
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -183,8 +182,8 @@ void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
     std::vector<ceres::CostFunction*> singles;
     for (const auto& p : points) {
       if (extrinsic) {
-        owned.push_back(
-            std::make_unique<ContinuousPointToPlaneExtrinsic>(p.pose, p.association, p.point_lidar));
+        owned.push_back(std::make_unique<ContinuousPointToPlaneExtrinsic>(p.pose, p.association,
+                                                                          p.point_lidar));
       } else {
         owned.push_back(std::make_unique<ContinuousPointToPlane>(p.pose, p.association));
       }
@@ -199,9 +198,8 @@ void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
     const Evaluated b = EvaluateProblem({&batch}, nullptr, at);
     EXPECT_NEAR(b.cost, a.cost, 1e-12 * a.cost) << "trial " << trial;
     ASSERT_EQ(a.gradient.size(), b.gradient.size());
-    const double g_scale = Eigen::Map<const Eigen::VectorXd>(a.gradient.data(),
-                                                             static_cast<Eigen::Index>(
-                                                                 a.gradient.size()))
+    const double g_scale = Eigen::Map<const Eigen::VectorXd>(
+                               a.gradient.data(), static_cast<Eigen::Index>(a.gradient.size()))
                                .cwiseAbs()
                                .maxCoeff();
     for (size_t i = 0; i < a.gradient.size(); ++i) {

@@ -118,8 +118,8 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
     std::vector<StateId> states = states_[j];
     if (extrinsic_ != nullptr) states.push_back(kExtrinsicKey);
     blocks->push_back(window->AddResidualBlock(
-        new ContinuousPointToPlaneBatch(std::move(points[j]), loss, extrinsic_ != nullptr),
-        nullptr, states));
+        new ContinuousPointToPlaneBatch(std::move(points[j]), loss, extrinsic_ != nullptr), nullptr,
+        states));
   }
 }
 

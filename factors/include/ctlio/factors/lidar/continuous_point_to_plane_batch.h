@@ -54,7 +54,7 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
  public:
   struct Point {
     std::shared_ptr<const SharedPoseInterpolation> pose;  // at the point's τ, on this interval
-    PlaneAssociation association;  // with the extrinsic its point_robot is not read
+    PlaneAssociation association;     // with the extrinsic its point_robot is not read
     Vec3 point_lidar = Vec3::Zero();  // q_l, with the extrinsic only
   };
 
@@ -94,9 +94,8 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
         association = &m;
       }
       const bool want_rl = extrinsic && rows[6] != nullptr;
-      const double e =
-          ContinuousPointToPlane::EvaluateAtKnots(*p.pose, *association, parameters,
-                                                  any ? rows : nullptr, want_rl ? &J_tau : nullptr);
+      const double e = ContinuousPointToPlane::EvaluateAtKnots(
+          *p.pose, *association, parameters, any ? rows : nullptr, want_rl ? &J_tau : nullptr);
       if (want_rl) {
         LiftPoseJacobian<1>(Eigen::Matrix<double, 1, 6>(-J_tau), parameters[6], rows[6]);
       }
@@ -120,7 +119,8 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
     residuals[n] = std::sqrt(std::max(cost_gap, 0.0));  // clamps rounding below 0 only
     if (jacobians != nullptr) {
       for (int b = 0; b < blocks_; ++b) {
-        if (jacobians[b] != nullptr) std::fill_n(jacobians[b] + n * kBlockSizes[b], kBlockSizes[b], 0.0);
+        if (jacobians[b] == nullptr) continue;
+        std::fill_n(jacobians[b] + n * kBlockSizes[b], kBlockSizes[b], 0.0);
       }
     }
     return true;
