@@ -329,7 +329,7 @@ std::vector<TimedPoint> LidarFrontend::Preprocess(const std::vector<TimedPoint>&
 }
 
 void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3& T_robot_lidar,
-                                SweepSelection* selection) {
+                                SweepSelection* selection, int threads) {
   const double size = NextVoxelSize();
   ++num_scans_;
   selection->indices.clear();
@@ -337,7 +337,7 @@ void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3&
   selection->keypoints.clear();
   thread_local std::vector<size_t> first;  // reused: a fresh one per sweep faulted its pages in
   RangeGatedVoxelIndices(sweep_lidar, size, options_.min_range, options_.max_range,
-                         options_.threads, &first);
+                         threads > 0 ? threads : options_.threads, &first);
   selection->indices.reserve(first.size());
   selection->points_robot.reserve(first.size());
   // C·p + r with C = I, r = 0 is p itself for a finite p (1·x + 0·y + 0·z + 0 = x; −0 becomes +0,

@@ -523,7 +523,11 @@ const PreparedScan& LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T
   // raw returns of a 128-beam sweep), then on the survivors in the robot frame, and the
   // keypoints: one stream, no intermediate copies (LidarFrontend::SelectSweep).
   thread_local SweepSelection selection;
-  frontend_.SelectSweep(scan.points, prepared.T_robot_lidar, &selection);
+  // With the overlap the second core runs the previous scan's map insertion and the
+  // marginalisation meanwhile (StartOverlappedStages): a second range-gate thread would only
+  // contend with them for the two cores (README "LIO latency": preprocessing 6.4 against 4.7 ms).
+  frontend_.SelectSweep(scan.points, prepared.T_robot_lidar, &selection,
+                        config_.overlap_stages ? 1 : config_.frontend.threads);
   prepared.points.resize(selection.indices.size());
   for (size_t j = 0; j < selection.indices.size(); ++j) {
     TimedPoint& p = prepared.points[j];

@@ -89,8 +89,10 @@ class LidarFrontend {
   // order, which a stream of filters computes alike. With an identity extrinsic the robot-frame
   // stage is skipped: it would keep every survivor (same points, gate and voxels, one point per
   // voxel already). Advances the scan counter.
+  // `threads` (>= 1) for the range gate and subsampling; 0 = LidarFrontendOptions::threads. The
+  // selection is the same for any count.
   void SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3& T_robot_lidar,
-                   SweepSelection* selection);
+                   SweepSelection* selection, int threads = 0);
   // The voxel size the next Preprocess call will use.
   double NextVoxelSize() const;
   // One keypoint per keypoint_voxel_size voxel of a preprocessed sweep.
