@@ -8,7 +8,9 @@
 //                plane written into it (LidarTerm::UpdateResidual), one that lost its plane
 //                loses its block, a new one gets a block (LidarTerm::AddResidual) — the window
 //                is that of removing all and adding them again up to the order of its blocks,
-//                without Ceres' cost of removing and adding ~10³ blocks per round;
+//                without Ceres' cost of removing and adding ~10³ blocks per round (a batched
+//                term instead replaces its few per-interval blocks each round,
+//                LidarTerm::SetBatchResiduals);
 //                fewer than min_associations: degenerate scan, the lidar term is dropped;
 //     solve      the window (solver_iterations Levenberg–Marquardt steps);
 //     converged? the newest pose moved less than convergence_translation/_rotation.
