@@ -1,8 +1,9 @@
 // Registration of one sweep against a map with the odometry's own components (SPEC §4): a
 // SlidingWindow, the ScanRegistration loop (associate → solve → converged?) and, for the
 // continuous-time fit, the pipeline's ContinuousLidarTerm on two GP knots tied by the Singer
-// prior. A rigid fit (one pose, PointToPlane) gives the no-motion baseline. Shared by the real
-// Newer College sweep test and the lidar benchmark.
+// prior (one residual block per keypoint or one for the interval, as options.residual_blocks). A
+// rigid fit (one pose, PointToPlane) gives the no-motion baseline. Shared by the real Newer College
+// sweep test and the lidar benchmark.
 #pragma once
 
 #include <vector>
@@ -84,6 +85,7 @@ inline RegistrationSummary RegisterContinuous(const VoxelMap& map,
   }
   window.AddResidualBlock(new gp::SingerPrior(model, t_k1 - t_k), nullptr, KnotPair(a, b));
   ContinuousLidarTerm term(model, t_k, t_k1, a, b, keypoints, &window);
+  term.set_batched(options.residual_blocks == "interval");  // as the odometry builds it
   const RegistrationSummary summary =
       ScanRegistration(options, OdometryConfig().min_associations).Register(map, &term, &window);
   *k = gp::ReadKnotState(window.State(a.pose), window.State(a.velocity),
