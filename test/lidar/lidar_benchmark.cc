@@ -254,7 +254,8 @@ void BM_ContinuousPointToPlaneInSolve(benchmark::State& state) {
 BENCHMARK(BM_ContinuousPointToPlaneInSolve)->Arg(1)->Arg(20);
 
 // The real-data test's pipeline on sweep 00 (25,109 points): preprocessing, keypoints, rigid
-// fit, then the two-knot continuous-time registration.
+// fit, then the two-knot continuous-time registration, with a residual block per keypoint
+// (Arg 0, residual_blocks "point") or one for the interval (Arg 1, the default).
 void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   if (!std::filesystem::is_directory(kFolder)) {
     state.SkipWithError("Newer College sweeps not found");
@@ -270,7 +271,8 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
     sweep[i] = {Rz * raw.points[i], raw.RelativeTime(i)};
     t_end = std::max(t_end, sweep[i].time);
   }
-  const LidarFrontendOptions options;
+  LidarFrontendOptions options;
+  options.residual_blocks = state.range(0) == 0 ? "point" : "interval";
   Vec6 qc, alpha;
   qc << 5000, 5000, 5000, 500, 500, 500;
   alpha << 0, 0, 0, 100, 100, 100;
@@ -293,7 +295,11 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   state.counters["keypoints"] = keypoints;
   state.counters["points"] = static_cast<double>(sweep.size());
 }
-BENCHMARK(BM_RegisterNewerCollegeSweep)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_RegisterNewerCollegeSweep)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace ctlio::lio
