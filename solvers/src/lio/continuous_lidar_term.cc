@@ -101,6 +101,7 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
                                             const std::shared_ptr<const ceres::LossFunction>& loss,
                                             SlidingWindow* window,
                                             std::vector<ceres::ResidualBlockId>* blocks) {
+  // batched() excludes the extrinsic: the blocks are on the interval's knots only.
   if (!batched()) throw std::logic_error("ContinuousLidarTerm::SetBatchResiduals: not batched");
   for (ceres::ResidualBlockId id : *blocks) window->RemoveResidualBlock(id);
   blocks->clear();
@@ -110,16 +111,12 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
     if (!associated[i]) continue;
     const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
     firing->set_active(true);  // a residual reads it in this round's solve
-    points[static_cast<size_t>(interval_of(i))].push_back(
-        {firing, planes[i], extrinsic_ != nullptr ? points_lidar_[i] : Vec3::Zero()});
+    points[static_cast<size_t>(interval_of(i))].push_back({firing, planes[i]});
   }
   for (size_t j = 0; j < points.size(); ++j) {
     if (points[j].empty()) continue;
-    std::vector<StateId> states = states_[j];
-    if (extrinsic_ != nullptr) states.push_back(kExtrinsicKey);
     blocks->push_back(window->AddResidualBlock(
-        new ContinuousPointToPlaneBatch(std::move(points[j]), loss, extrinsic_ != nullptr), nullptr,
-        states));
+        new ContinuousPointToPlaneBatch(std::move(points[j]), loss), nullptr, states_[j]));
   }
 }
 

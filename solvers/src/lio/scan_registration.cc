@@ -93,40 +93,46 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
         associated[i] = associator.Associate(q[i], p_map[i], &planes[i]) ? 1 : 0;
       }
     });
-    // This round's residuals replace the previous round's: a keypoint associated again keeps
-    // its residual block with the new plane written into it (the same residual as a new block
-    // on that plane), one that lost its plane loses its block, a new one gets a block.
-    // One loss for the new blocks of the round, shared by them; once a residual uses it the
-    // window owns it (ref-counted by Ceres, deleted with the last such residual).
-    std::unique_ptr<ceres::LossFunction> loss = batched ? nullptr : MakeLidarLoss(options_);
-    bool loss_used = false;
-    int associations = 0;
-    for (size_t i = 0; batched && i < n; ++i) {
-      if (!associated[i]) continue;
-      whitened[i] = planes[i];
-      whitened[i].weight /= options_.point_noise_sigma;
-      ++associations;
-    }
-    if (batched && associations >= min_associations_) {
-      term->SetBatchResiduals(associated, whitened, batch_loss, window, &batch_blocks);
-    }
-    for (size_t i = 0; !batched && i < n; ++i) {
-      if (!associated[i]) {
-        if (block[i] != nullptr) window->RemoveResidualBlock(block[i]);
-        block[i] = nullptr;
-        continue;
-      }
+    // This round's residuals replace the previous round's, on the whitened planes.
+    const auto whiten = [&](size_t i) {
       PlaneAssociation a = planes[i];
       a.weight /= options_.point_noise_sigma;
-      if (block[i] != nullptr) {
-        term->UpdateResidual(i, a);
-      } else {
-        block[i] = term->AddResidual(i, a, loss.get(), window);
-        loss_used = true;
+      return a;
+    };
+    int associations = 0;
+    if (batched) {  // the term replaces its per-interval blocks at once
+      for (size_t i = 0; i < n; ++i) {
+        if (!associated[i]) continue;
+        whitened[i] = whiten(i);
+        ++associations;
       }
-      ++associations;
+      if (associations >= min_associations_) {
+        term->SetBatchResiduals(associated, whitened, batch_loss, window, &batch_blocks);
+      }
+    } else {
+      // A keypoint associated again keeps its residual block with the new plane written into it
+      // (the same residual as a new block on that plane), one that lost its plane loses its
+      // block, a new one gets a block. One loss for the new blocks of the round, shared by them;
+      // once a residual uses it the window owns it (ref-counted by Ceres, deleted with the last
+      // such residual).
+      std::unique_ptr<ceres::LossFunction> loss = MakeLidarLoss(options_);
+      bool loss_used = false;
+      for (size_t i = 0; i < n; ++i) {
+        if (!associated[i]) {
+          if (block[i] != nullptr) window->RemoveResidualBlock(block[i]);
+          block[i] = nullptr;
+          continue;
+        }
+        if (block[i] != nullptr) {
+          term->UpdateResidual(i, whiten(i));
+        } else {
+          block[i] = term->AddResidual(i, whiten(i), loss.get(), window);
+          loss_used = true;
+        }
+        ++associations;
+      }
+      if (loss_used) loss.release();
     }
-    if (loss_used) loss.release();
     summary.associations = associations;
     if (summary.associations < min_associations_) {
       remove_all();
