@@ -8,18 +8,12 @@
 #include <random>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/singer_prior.h"
 
 namespace ctlio::gp {
 namespace {
-
-SingerModel<6> Model(bool singer) {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  return SingerModel<6>(qc, singer ? alpha : Vec6::Zero());
-}
 
 struct Fixture {
   KnotState k, k1;
@@ -43,7 +37,7 @@ struct Fixture {
 
 void PriorEvaluate(benchmark::State& state, bool singer, bool with_jacobians) {
   const Fixture f;
-  const SingerPrior prior(Model(singer), 0.1);
+  const SingerPrior prior(ctlio::testing::NewerCollegeSingerModel(singer), 0.1);
   const double* p[6] = {f.p0.data(), f.v0.data(), f.a0.data(),
                         f.p1.data(), f.v1.data(), f.a1.data()};
   double r[18];
@@ -66,7 +60,7 @@ BENCHMARK(BM_SingerPrior_Jacobians);
 BENCHMARK(BM_SingerPrior_Value);
 
 void BM_BuildInterpolator(benchmark::State& state) {
-  const SingerModel<6> model = Model(state.range(0) != 0);
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0);
   double tau = 0.05;
   for (auto _ : state) {
     GpInterpolator interp(model, 0.0, 0.1, tau);
@@ -78,7 +72,8 @@ BENCHMARK(BM_BuildInterpolator)->Arg(0)->Arg(1);
 // Arg 0: WNOJ, 1: Singer (α = 100 on rotation). Mid time τ = t_k + T/2.
 void BM_InterpolatePose_Jacobians(benchmark::State& state) {
   const Fixture f;
-  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0), 0.0,
+                              0.1, 0.05);
   SE3 T;
   PoseJacobian J0, J1;
   for (auto _ : state) {
@@ -105,7 +100,8 @@ BENCHMARK(BM_LocalVariables_Jacobians);
 // more lidar firing on an interval in the solve).
 void BM_InterpolatePose_JacobiansSharedInterval(benchmark::State& state) {
   const Fixture f;
-  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0), 0.0,
+                              0.1, 0.05);
   const LocalVariables lv(f.k, f.k1, true);
   SE3 T;
   PoseJacobian J0, J1;
@@ -120,7 +116,8 @@ BENCHMARK(BM_InterpolatePose_JacobiansSharedInterval)->Arg(0)->Arg(1);
 
 void BM_InterpolatePose_Value(benchmark::State& state) {
   const Fixture f;
-  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0), 0.0,
+                              0.1, 0.05);
   SE3 T;
   for (auto _ : state) {
     interp.Pose(f.k, f.k1, &T, nullptr, nullptr);
@@ -131,7 +128,7 @@ BENCHMARK(BM_InterpolatePose_Value)->Arg(0)->Arg(1);
 
 void BM_InterpolatePose_JacobiansIncludingBuild(benchmark::State& state) {
   const Fixture f;
-  const SingerModel<6> model = Model(state.range(0) != 0);
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0);
   SE3 T;
   PoseJacobian J0, J1;
   for (auto _ : state) {
@@ -146,7 +143,8 @@ BENCHMARK(BM_InterpolatePose_JacobiansIncludingBuild)->Arg(0)->Arg(1);
 
 void BM_InterpolateState_Jacobians(benchmark::State& state) {
   const Fixture f;
-  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0), 0.0,
+                              0.1, 0.05);
   KnotState x;
   StateJacobian J0, J1;
   for (auto _ : state) {
@@ -160,7 +158,7 @@ BENCHMARK(BM_InterpolateState_Jacobians)->Arg(0)->Arg(1);
 
 void BM_InterpolateState_JacobiansIncludingBuild(benchmark::State& state) {
   const Fixture f;
-  const SingerModel<6> model = Model(state.range(0) != 0);
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0);
   KnotState x;
   StateJacobian J0, J1;
   for (auto _ : state) {
@@ -175,7 +173,8 @@ BENCHMARK(BM_InterpolateState_JacobiansIncludingBuild)->Arg(0)->Arg(1);
 
 void BM_InterpolateState_Value(benchmark::State& state) {
   const Fixture f;
-  const GpInterpolator interp(Model(state.range(0) != 0), 0.0, 0.1, 0.05);
+  const GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(state.range(0) != 0), 0.0,
+                              0.1, 0.05);
   KnotState x;
   for (auto _ : state) {
     interp.State(f.k, f.k1, &x, nullptr, nullptr);

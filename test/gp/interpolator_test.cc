@@ -14,6 +14,7 @@
 #include <random>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 
 namespace ctlio::gp {
 namespace {
@@ -120,13 +121,6 @@ class ExtrapolatedStateCost : public ceres::SizedCostFunction<18, 7, 6, 6> {
   const GpExtrapolator& ex_;
   SE3 T_bar_inv_;
 };
-
-SingerModel<6> LioModel() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  return SingerModel<6>(qc, alpha);
-}
 
 struct Case {
   const char* name;
@@ -264,7 +258,7 @@ TEST(GpInterpolatorTest, TrajectoryOnThePriorMeanIsReproduced) {
 
 TEST(GpInterpolatorTest, EndpointsReturnTheKnots) {
   std::mt19937 rng(11);
-  const SingerModel<6> model = LioModel();
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
   const Knots K = MakeKnots(rng, Cases()[1]);
   KnotState x;
   GpInterpolator(model, 0.0, 0.1, 0.0).State(K.k, K.k1, &x, nullptr, nullptr);
@@ -274,7 +268,7 @@ TEST(GpInterpolatorTest, EndpointsReturnTheKnots) {
 }
 
 TEST(GpInterpolatorTest, RejectsBadTimes) {
-  const SingerModel<6> model = LioModel();
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
   EXPECT_THROW(GpInterpolator(model, 1.0, 1.0, 1.0), std::runtime_error);
   EXPECT_THROW(GpInterpolator(model, 1.0, 2.0, 2.5), std::runtime_error);
   EXPECT_THROW(GpInterpolator(model, 1.0, 2.0, 0.5), std::runtime_error);
@@ -491,7 +485,7 @@ TEST(GpInterpolatorRowsTest, SelectedRowsMatchNumeric) {
 // computes and how large the difference is (see the README's IMU section).
 TEST(GpInterpolatorTest, AccelerationVersusDerivativeOfVelocity) {
   std::mt19937 rng(29);
-  const SingerModel<6> model = LioModel();
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
   const double t0 = 0.0, dt = 0.1;
   double worst_general = 0.0, worst_fixed_axis = 0.0;
   for (int trial = 0; trial < 20; ++trial) {
@@ -606,7 +600,7 @@ TEST(GpInterpolatorTest, StateRateMatchesCentralDifferences) {
     }
   }
   // Without with_time_derivative, asking for the rate is an error.
-  const SingerModel<6> model = LioModel();
+  const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
   StateRate rate;
   KnotState k;
   EXPECT_THROW(GpInterpolator(model, 0.0, 0.1, 0.05)

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 #include "ctlio/factors/gp/shared_knot_interval.h"
 #include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/imu/imu_measurement.h"
@@ -38,17 +39,11 @@ struct Knots {
   }
 };
 
-gp::SingerModel<6> Model() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  return gp::SingerModel<6>(qc, alpha);
-}
-
 void BM_AccelMeasurementWithJacobians(benchmark::State& state) {
   Knots k;
   const ImuAccelMeasurement cost(
-      Model(), 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 9.8), 0.156 * Mat3::Identity(), 9.81,
+      ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 9.8),
+      0.156 * Mat3::Identity(), 9.81,
       state.range(0) ? AccelModel::kSpecificForce : AccelModel::kBodyCentric);
   double r[3];
   for (auto _ : state) {
@@ -63,7 +58,7 @@ BENCHMARK(BM_AccelMeasurementWithJacobians)->Arg(0)->Arg(1);
 // Jacobians, then the three rows it reads): the "before" of the speed-up, in the same run.
 void BM_AccelMeasurementWithJacobiansFullState(benchmark::State& state) {
   Knots k;
-  const gp::GpInterpolator interp(Model(), 0.0, 0.1, 0.043);
+  const gp::GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.043);
   const Mat3 S = SqrtInformation(0.156 * Mat3::Identity());
   const Vec3 accel(0.1, 0.2, 9.8), g_i(0, 0, -9.81);
   double r[3];
@@ -105,7 +100,7 @@ BENCHMARK(BM_AccelMeasurementWithJacobiansFullState);
 // The interpolator alone: the full 18×18 Jacobians and the rows each IMU factor reads.
 void BM_InterpolatorState(benchmark::State& state) {
   Knots k;
-  const gp::GpInterpolator interp(Model(), 0.0, 0.1, 0.043);
+  const gp::GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.043);
   const gp::KnotState a = gp::ReadKnotState(k.params[0], k.params[1], k.params[2]);
   const gp::KnotState b = gp::ReadKnotState(k.params[3], k.params[4], k.params[5]);
   const unsigned masks[] = {gp::kAllStateRows, gp::kRotationRows | gp::kLinearAccelerationRows,
@@ -129,8 +124,8 @@ BENCHMARK(BM_InterpolatorState)->Arg(0)->Arg(1)->Arg(2);
 
 void BM_AccelMeasurementValueOnly(benchmark::State& state) {
   Knots k;
-  const ImuAccelMeasurement cost(Model(), 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 9.8),
-                                 0.156 * Mat3::Identity());
+  const ImuAccelMeasurement cost(ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.043,
+                                 Vec3(0.1, 0.2, 9.8), 0.156 * Mat3::Identity());
   double r[3];
   for (auto _ : state) {
     cost.Evaluate(k.params, r, nullptr);
@@ -141,7 +136,7 @@ BENCHMARK(BM_AccelMeasurementValueOnly);
 
 void BM_AccelMeasurementConstructAndEvaluate(benchmark::State& state) {
   Knots k;
-  const gp::SingerModel<6> model = Model();
+  const gp::SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
   double r[3];
   for (auto _ : state) {
     const ImuAccelMeasurement cost(model, 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 9.8),
@@ -154,8 +149,8 @@ BENCHMARK(BM_AccelMeasurementConstructAndEvaluate);
 
 void BM_GyroMeasurementWithJacobians(benchmark::State& state) {
   Knots k;
-  const ImuGyroMeasurement cost(Model(), 0.0, 0.1, 0.043, Vec3(0.1, 0.2, 0.3),
-                                4.326e-4 * Mat3::Identity());
+  const ImuGyroMeasurement cost(ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.043,
+                                Vec3(0.1, 0.2, 0.3), 4.326e-4 * Mat3::Identity());
   double r[3];
   for (auto _ : state) {
     cost.Evaluate(k.params, r, k.jacobians);
@@ -181,8 +176,8 @@ void BM_ImuSampleInSolve(benchmark::State& state) {
   std::vector<std::unique_ptr<ImuGyroMeasurement>> gyro;
   std::vector<std::unique_ptr<ImuAccelMeasurement>> accel;
   for (int i = 0; i < n; ++i) {
-    states.push_back(std::make_shared<gp::SharedStateInterpolation>(Model(), 0.0, 0.1,
-                                                                    0.1 * (i + 0.5) / n, knots));
+    states.push_back(std::make_shared<gp::SharedStateInterpolation>(
+        ctlio::testing::NewerCollegeSingerModel(), 0.0, 0.1, 0.1 * (i + 0.5) / n, knots));
     states.back()->set_interval(interval);
     gyro.push_back(std::make_unique<ImuGyroMeasurement>(states.back(), Vec3(0.1, 0.2, 0.3),
                                                         4.326e-4 * Mat3::Identity()));

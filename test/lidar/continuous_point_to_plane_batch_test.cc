@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane_extrinsic.h"
 #include "lidar/random_association.h"
 
@@ -27,13 +28,6 @@ using testing::PoseParameters;
 using testing::RandomAssociation;
 using testing::RandomPose;
 using testing::RandomVec6;
-
-gp::SingerModel<6> Model() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  return gp::SingerModel<6>(qc, alpha);
-}
 
 // The knot blocks and, for the extrinsic form, T_rl.
 struct Knots {
@@ -76,7 +70,7 @@ Knots WithoutExtrinsic(Knots s) {
 // n points on [0, 0.1] s, the last two on one firing (one shared interpolation).
 std::vector<ContinuousPointToPlaneBatch::Point> RandomPoints(std::mt19937& rng, int n) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const auto model = Model();
+  const auto model = ctlio::testing::NewerCollegeSingerModel();
   std::vector<ContinuousPointToPlaneBatch::Point> points;
   std::shared_ptr<const SharedPoseInterpolation> firing;
   for (int i = 0; i < n; ++i) {

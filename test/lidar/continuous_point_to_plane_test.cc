@@ -12,6 +12,7 @@
 #include <random>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 #include "lidar/random_association.h"
 
 namespace ctlio {
@@ -22,14 +23,6 @@ using testing::PoseParameters;
 using testing::RandomAssociation;
 using testing::RandomPose;
 using testing::RandomVec6;
-
-gp::SingerModel<6> Model(bool singer) {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;  // SPEC §4, Newer College
-  alpha << 0, 0, 0, 100, 100, 100;
-  if (!singer) alpha.setZero();
-  return gp::SingerModel<6>(qc, alpha);
-}
 
 struct Knots {
   std::vector<double> pose_k, pose_k1;
@@ -55,7 +48,7 @@ Knots RandomKnots(std::mt19937& rng, double max_angle, double max_step, double v
 
 TEST(ContinuousPointToPlane, ResidualIsSinglePoseResidualAtInterpolatedPose) {
   std::mt19937 rng(31);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   for (int trial = 0; trial < 10; ++trial) {
     const Knots s = RandomKnots(rng, 3.0, 0.5, 2.0);
     const double tau = 0.1 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
@@ -77,7 +70,7 @@ TEST(ContinuousPointToPlane, ResidualIsSinglePoseResidualAtInterpolatedPose) {
 // single-pose factor's.
 TEST(ContinuousPointToPlane, AtKnotTimesEqualsSinglePoseFactor) {
   std::mt19937 rng(32);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   const Knots s = RandomKnots(rng, 3.0, 0.5, 2.0);
   const PlaneAssociation m = RandomAssociation(rng);
   for (const auto& [tau, pose] :
@@ -96,7 +89,7 @@ TEST(ContinuousPointToPlane, AtKnotTimesEqualsSinglePoseFactor) {
 void CheckJacobians(bool singer, double max_angle, double max_step, double velocity_scale,
                     uint32_t seed) {
   std::mt19937 rng(seed);
-  const auto model = Model(singer);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(singer);
   const PoseManifold pose_manifold;
   const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, nullptr,
                                                          &pose_manifold, nullptr, nullptr};
@@ -122,7 +115,7 @@ TEST(ContinuousPointToPlane, JacobiansNearIdentity) { CheckJacobians(true, 1e-7,
 
 TEST(ContinuousPointToPlane, JacobiansKnotNearPi) {
   std::mt19937 rng(37);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   const PoseManifold pose_manifold;
   const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, nullptr,
                                                          &pose_manifold, nullptr, nullptr};
@@ -143,7 +136,7 @@ TEST(ContinuousPointToPlane, JacobiansKnotNearPi) {
 // Ceres may ask for any subset of the Jacobians: each must equal the full evaluation's.
 TEST(ContinuousPointToPlane, PartialJacobianRequests) {
   std::mt19937 rng(38);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   const Knots s = RandomKnots(rng, 2.0, 0.5, 2.0);
   const ContinuousPointToPlane cost(
       std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.037), RandomAssociation(rng));
@@ -218,7 +211,7 @@ Knots KnotsOfKind(std::mt19937& rng, int kind) {
 
 void CheckSharedJacobians(bool prepared, uint32_t seed) {
   std::mt19937 rng(seed);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   const PoseManifold pose_manifold;
   const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, nullptr, nullptr,
                                                          &pose_manifold, nullptr, nullptr};
@@ -255,7 +248,7 @@ TEST(ContinuousPointToPlane, SharedJacobiansComputedPath) { CheckSharedJacobians
 // built on a plain interpolator.
 TEST(ContinuousPointToPlane, PreparedEqualsComputed) {
   std::mt19937 rng(41);
-  const auto model = Model(true);
+  const auto model = ctlio::testing::NewerCollegeSingerModel(true);
   const BoundKnots blocks{RandomKnots(rng, 2.0, 0.5, 2.0)};
   const auto interpolator = std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.061);
   const PlaneAssociation m = RandomAssociation(rng);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/gradient_check.h"
+#include "common/singer_model.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/shared_knot_interval.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
@@ -176,10 +177,7 @@ BENCHMARK(BM_PointToPlaneWithJacobian);
 
 void BM_ContinuousPointToPlane(benchmark::State& state) {
   std::mt19937 rng(4);
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  const gp::SingerModel<6> model(qc, alpha);
+  const gp::SingerModel<6> model = testing::NewerCollegeSingerModel();
   const SE3 T_k = testing::RandomPose(rng, 1.0, 5.0);
   const auto pk = testing::PoseParameters(T_k);
   const auto pk1 = testing::PoseParameters(testing::RandomPose(rng, 0.2, 0.3) * T_k);
@@ -209,10 +207,7 @@ BENCHMARK(BM_ContinuousPointToPlane)->Arg(0)->Arg(1);
 // BM_ContinuousPointToPlane/1, which interpolates on its own.
 void BM_ContinuousPointToPlaneInSolve(benchmark::State& state) {
   std::mt19937 rng(4);
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  const gp::SingerModel<6> model(qc, alpha);
+  const gp::SingerModel<6> model = testing::NewerCollegeSingerModel();
   const SE3 T_k = testing::RandomPose(rng, 1.0, 5.0);
   const auto pk = testing::PoseParameters(T_k);
   const auto pk1 = testing::PoseParameters(testing::RandomPose(rng, 0.2, 0.3) * T_k);
@@ -273,10 +268,7 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   }
   LidarFrontendOptions options;
   options.residual_blocks = state.range(0) == 0 ? "point" : "interval";
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  const gp::SingerModel<6> model(qc, alpha);
+  const gp::SingerModel<6> model = testing::NewerCollegeSingerModel();
   LidarFrontend map_frontend(options);
   map_frontend.UpdateMap(deskewed.points, Vec3::Zero());
   int keypoints = 0;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "common/singer_model.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/solvers/lio/frontend.h"
@@ -35,13 +36,6 @@ double Median(std::vector<double> v) {
   const size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + mid, v.end());
   return v[mid];
-}
-
-gp::SingerModel<6> NewerCollegeModel() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;  // SPEC §4, Singer-LIO on Newer College
-  alpha << 0, 0, 0, 100, 100, 100;
-  return gp::SingerModel<6>(qc, alpha);
 }
 
 struct SweepResult {
@@ -87,7 +81,7 @@ SweepResult RegisterSweep(const std::string& id) {
   SweepResult result;
   result.points = raw.size();
   result.keypoints = keypoints.size();
-  const gp::SingerModel<6> model = NewerCollegeModel();
+  const gp::SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();
 
   std::vector<double> d(raw.size());
   for (size_t i = 0; i < raw.size(); ++i) d[i] = (sweep[i].point - deskewed.points[i]).norm();

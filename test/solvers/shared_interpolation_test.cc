@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "common/singer_model.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/gp/shared_state_interpolation.h"
@@ -27,13 +28,6 @@ namespace {
 
 constexpr double kT1 = 0.1;  // knot times 0 and kT1
 constexpr int kFirings = 12, kPointsPerFiring = 8, kImuSamples = 10;
-
-gp::SingerModel<6> Model() {
-  Vec6 qc, alpha;
-  qc << 5000, 5000, 5000, 500, 500, 500;
-  alpha << 0, 0, 0, 100, 100, 100;
-  return gp::SingerModel<6>(qc, alpha);
-}
 
 struct Scene {
   gp::KnotState truth0, truth1, guess0, guess1;
@@ -64,7 +58,8 @@ Scene MakeScene(uint32_t seed, int firings = kFirings) {
   s.guess1.velocity += vec6(0.2);
   for (int f = 0; f < firings; ++f) {
     s.tau.push_back(kT1 * (f + 0.5) / firings);
-    const gp::GpInterpolator interp(Model(), 0.0, kT1, s.tau.back());
+    const gp::GpInterpolator interp(ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1,
+                                    s.tau.back());
     SE3 T_rm;
     interp.Pose(s.truth0, s.truth1, &T_rm, nullptr, nullptr);
     s.planes.emplace_back();
@@ -104,11 +99,13 @@ Built Build(const Scene& s, bool shared, int threads = 1) {
       StatePrior::FromCovariance(s.guess0.pose, s.guess0.velocity, s.guess0.acceleration,
                                  1e-2 * Eigen::Matrix<double, 18, 18>::Identity()),
       nullptr, {0, 1, 2});
-  w.AddResidualBlock(new gp::SingerPrior(Model(), kT1), nullptr, ids);
+  w.AddResidualBlock(new gp::SingerPrior(ctlio::testing::NewerCollegeSingerModel(), kT1), nullptr,
+                     ids);
   const SharedPoseInterpolation::KnotBlocks blocks = {w.State(0), w.State(1), w.State(2),
                                                       w.State(3), w.State(4), w.State(5)};
   for (size_t f = 0; f < s.tau.size(); ++f) {
-    auto interpolator = std::make_shared<const gp::GpInterpolator>(Model(), 0.0, kT1, s.tau[f]);
+    auto interpolator = std::make_shared<const gp::GpInterpolator>(
+        ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1, s.tau[f]);
     std::shared_ptr<SharedPoseInterpolation> firing;
     if (shared) {
       firing = std::make_shared<SharedPoseInterpolation>(interpolator, blocks);
@@ -134,7 +131,8 @@ Built Build(const Scene& s, bool shared, int threads = 1) {
   for (int i = 0; i < kImuSamples; ++i) {
     const double tau = kT1 * (i + 0.3) / kImuSamples;
     gp::KnotState x;
-    gp::GpInterpolator(Model(), 0.0, kT1, tau).State(s.truth0, s.truth1, &x, nullptr, nullptr);
+    gp::GpInterpolator(ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1, tau)
+        .State(s.truth0, s.truth1, &x, nullptr, nullptr);
     const Vec3 gyro = -x.velocity.tail<3>();
     const Vec3 accel = -x.acceleration.head<3>() +
                        x.velocity.tail<3>().cross(x.velocity.head<3>()) -
@@ -143,15 +141,17 @@ Built Build(const Scene& s, bool shared, int threads = 1) {
     const auto exact = imu::AccelModel::kSpecificForce;
     ceres::CostFunction *g = nullptr, *a = nullptr;
     if (shared) {
-      const auto state =
-          std::make_shared<gp::SharedStateInterpolation>(Model(), 0.0, kT1, tau, blocks);
+      const auto state = std::make_shared<gp::SharedStateInterpolation>(
+          ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1, tau, blocks);
       w.shared_interpolations().Add(state);
       b.imu.push_back(state);
       g = new imu::ImuGyroMeasurement(state, gyro, cov);
       a = new imu::ImuAccelMeasurement(state, accel, cov, 9.81, exact);
     } else {
-      g = new imu::ImuGyroMeasurement(Model(), 0.0, kT1, tau, gyro, cov);
-      a = new imu::ImuAccelMeasurement(Model(), 0.0, kT1, tau, accel, cov, 9.81, exact);
+      g = new imu::ImuGyroMeasurement(ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1, tau,
+                                      gyro, cov);
+      a = new imu::ImuAccelMeasurement(ctlio::testing::NewerCollegeSingerModel(), 0.0, kT1, tau,
+                                       accel, cov, 9.81, exact);
     }
     w.AddResidualBlock(g, nullptr, imu_ids);
     std::vector<StateId> accel_ids = imu_ids;
