@@ -250,7 +250,18 @@ const std::vector<StateId>& SlidingWindow::StatesOf(ceres::ResidualBlockId id) c
 ceres::Solver::Summary SlidingWindow::Solve() {
   if (states_.empty()) Throw<std::logic_error>(__LINE__, "Solve() on an empty window");
   ceres::Solver::Summary summary;
-  shared_interpolations_->set_threads(options_.solver.num_threads);
+  // options_.threads serve the solve (solving()); the linearisations outside it keep one thread.
+  struct Solving {
+    SlidingWindow* w;
+    explicit Solving(SlidingWindow* window) : w(window) {
+      w->solving_ = true;
+      w->shared_interpolations_->set_threads(w->options_.threads);
+    }
+    ~Solving() {
+      w->solving_ = false;
+      w->shared_interpolations_->set_threads(1);
+    }
+  } solving(this);
   ceres::Solve(options_.solver, problem_.get(), &summary);
   return summary;
 }

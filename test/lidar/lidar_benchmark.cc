@@ -250,7 +250,8 @@ BENCHMARK(BM_ContinuousPointToPlaneInSolve)->Arg(1)->Arg(20);
 
 // The real-data test's pipeline on sweep 00 (25,109 points): preprocessing, keypoints, rigid
 // fit, then the two-knot continuous-time registration, with a residual block per keypoint
-// (Arg 0, residual_blocks "point") or one for the interval (Arg 1, the default).
+// (first arg 0, residual_blocks "point") or one for the interval (1, the default); second arg: the
+// threads of the front end and of the window's solve (lidar_frontend.threads = window.threads).
 void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   if (!std::filesystem::is_directory(kFolder)) {
     state.SkipWithError("Newer College sweeps not found");
@@ -268,6 +269,7 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   }
   LidarFrontendOptions options;
   options.residual_blocks = state.range(0) == 0 ? "point" : "interval";
+  options.threads = static_cast<int>(state.range(1));
   const gp::SingerModel<6> model = testing::NewerCollegeSingerModel();
   LidarFrontend map_frontend(options);
   map_frontend.UpdateMap(deskewed.points, Vec3::Zero());
@@ -288,8 +290,9 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(sweep.size());
 }
 BENCHMARK(BM_RegisterNewerCollegeSweep)
-    ->Arg(0)
-    ->Arg(1)
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Args({1, 2})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

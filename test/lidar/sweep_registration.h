@@ -26,6 +26,7 @@ inline SlidingWindowOptions SweepWindowOptions(const LidarFrontendOptions& optio
   SlidingWindowOptions o;
   o.solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   o.solver.max_num_iterations = options.solver_iterations;
+  o.threads = options.threads;  // as window.threads: the interpolations and lidar rows
   return o;
 }
 

@@ -51,22 +51,26 @@ TEST(LioPipeline, SingerLioAndBaselineTrackShortSimulatedSequence) {
 }
 
 // lidar_frontend.threads: the association and the range gate run in parallel chunks, merged in
-// order, so two threads give the same trajectory as one, bit for bit. The voxel-plane association
-// tracks the same sequence within the same bound.
+// order, so two threads give the same trajectory as one, bit for bit; so do window.threads (the
+// interpolations and the rows of the interval blocks in chunks), also with the overlap. The
+// voxel-plane association tracks the same sequence within the same bound.
 TEST(LioPipeline, FrontendThreadsAndVoxelPlanes) {
   // Singer-LIO only: the baseline runs the same front end (ScanRegistration, PrepareScan).
-  for (const LioMethod m : {LioMethod::kSingerLio}) {
+  for (const int variant : {0, 1, 2}) {
+    const LioMethod m = LioMethod::kSingerLio;
     sim::SimulatedSource one_source(ShortSequence());
     const lioapp::RunSummary one = lioapp::RunOdometry(one_source, Config(m));
     OdometryConfig two_threads = Config(m);
     two_threads.frontend.threads = 2;
+    if (variant >= 1) two_threads.solver_threads = 2;
+    if (variant == 2) two_threads.overlap_stages = true;
     sim::SimulatedSource two_source(ShortSequence());
     const lioapp::RunSummary two = lioapp::RunOdometry(two_source, two_threads);
     ASSERT_EQ(one.trajectory.size(), two.trajectory.size());
     ASSERT_EQ(one.trajectory.size(), 10u);
     for (size_t i = 0; i < one.trajectory.size(); ++i) {
       EXPECT_EQ(one.trajectory[i].pose.Matrix(), two.trajectory[i].pose.Matrix())
-          << LioMethodName(m) << " scan " << i;
+          << "variant " << variant << " scan " << i;
       EXPECT_EQ(one.scans[i].associations, two.scans[i].associations);
     }
   }

@@ -35,7 +35,10 @@ SlidingWindowOptions WindowOptions(const OdometryConfig& config) {
   SlidingWindowOptions o;
   o.solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   o.solver.max_num_iterations = config.frontend.solver_iterations;
-  o.solver.num_threads = config.solver_threads;
+  // window.threads go to the window's own work (interpolations, lidar rows) on ParallelFor's
+  // persistent helpers; Ceres' evaluation stays on one thread: its thread pool wakes its workers
+  // per loop, which cost more than they saved here (README "LIO latency").
+  o.threads = config.solver_threads;
   o.solver.minimizer_progress_to_stdout = false;
   o.solver.logging_type = ceres::SILENT;
   return o;

@@ -41,7 +41,7 @@ class SharedInterpolationCallback final : public ceres::EvaluationCallback {
     interpolation->set_interval(std::move(interval));
   }
 
-  // Threads for PrepareForEvaluation (the window sets its solver's num_threads here): the
+  // Threads for PrepareForEvaluation (the window sets SlidingWindowOptions::threads here): the
   // intervals are formed first, on the calling thread, then the interpolations, which only read
   // them and write their own results, in contiguous chunks. Same results for any count.
   void set_threads(int threads) { threads_ = std::max(threads, 1); }

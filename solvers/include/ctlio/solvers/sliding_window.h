@@ -64,6 +64,11 @@ struct SlidingWindowOptions {
   // Eigenvalue cut-off of the Jacobi-scaled pseudo-inverse and square root
   // (schur_complement.h).
   double relative_eigenvalue_threshold = kDefaultRelativeEigenvalueThreshold;
+  // Threads of the window's own per-evaluation work, on ParallelFor's persistent helpers: the
+  // shared interpolations (SharedInterpolationCallback) and the rows of batched lidar blocks
+  // (ContinuousPointToPlaneBatch::set_row_runner). Independent of solver.num_threads (Ceres' own
+  // threads, which evaluate residual blocks in parallel); the same estimates for any count.
+  int threads = 1;
 };
 
 struct MarginalizationReport {
@@ -121,6 +126,10 @@ class SlidingWindow {
   // ---- Estimation ---------------------------------------------------------------------------
   // Throws std::logic_error on an empty window.
   ceres::Solver::Summary Solve();
+  // True while Solve() runs: the window's options().threads serve its solve only (with the
+  // odometry's window.overlap the marginalisation runs on a second thread beside the next scan's
+  // preprocessing, where more threads would only contend for the cores).
+  bool solving() const { return solving_; }
   MarginalizationReport Marginalize(const std::vector<StateId>& ids);
 
   // Joint marginal covariance (tangent spaces, in the order of `ids`) of the listed states under
@@ -155,6 +164,7 @@ class SlidingWindow {
   StateBlock& Get(StateId id, int line);
 
   SlidingWindowOptions options_;
+  bool solving_ = false;
   std::unique_ptr<SharedInterpolationCallback> shared_interpolations_;  // outlives problem_
   std::unique_ptr<ceres::Problem> problem_;
   std::map<StateId, StateBlock> states_;

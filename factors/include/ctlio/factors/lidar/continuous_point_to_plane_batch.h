@@ -39,7 +39,9 @@
 #include <ceres/loss_function.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <utility>
@@ -69,53 +71,77 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
     for (int b = 0; b < blocks_; ++b) mutable_parameter_block_sizes()->push_back(kBlockSizes[b]);
   }
 
+  // Runs rows(begin, end) over a split of [0, n) into contiguous ranges, possibly concurrently,
+  // and returns when all have run (e.g. ctlio::ParallelFor's chunks).
+  using RowRunner =
+      std::function<void(size_t n, const std::function<void(size_t begin, size_t end)>& rows)>;
+
+  // Optional: the rows are independent, so a runner may evaluate them on several threads. Each
+  // row writes only its own residual and Jacobian rows, and the constant row sums the rows' terms
+  // in row order afterwards: the same values, bit for bit, for any split.
+  void set_row_runner(RowRunner runner) { row_runner_ = std::move(runner); }
+
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const size_t n = points_.size();
     const bool extrinsic = blocks_ == 7;
     const SE3 T_rl = extrinsic ? PoseManifold::Pose(parameters[6]) : SE3();
-    double* rows[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
-    double cost_gap = 0.0;  // Σ ρ(e²) − ρ'(e²)·e²
-    PlaneAssociation m;
-    Eigen::Matrix<double, 1, 6> J_tau;
-    for (size_t i = 0; i < n; ++i) {
-      bool any = false;
-      if (jacobians != nullptr) {
+    std::vector<double> gaps(loss_ != nullptr ? n : 0);  // per row ρ(e²) − ρ'(e²)·e²
+    std::atomic<bool> concave{true};
+    const auto evaluate_rows = [&](size_t begin, size_t end) {
+      double* rows[7] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+      PlaneAssociation m;
+      Eigen::Matrix<double, 1, 6> J_tau;
+      for (size_t i = begin; i < end; ++i) {
+        bool any = false;
+        if (jacobians != nullptr) {
+          for (int b = 0; b < blocks_; ++b) {
+            rows[b] = jacobians[b] != nullptr ? jacobians[b] + i * kBlockSizes[b] : nullptr;
+            any = any || rows[b] != nullptr;
+          }
+        }
+        const Point& p = points_[i];
+        const PlaneAssociation* association = &p.association;
+        if (extrinsic) {  // as ContinuousPointToPlaneExtrinsic: q = T_rl·q_l, de/dδ_rl = −de/dδT(τ)
+          m = p.association;
+          m.point_robot = T_rl * p.point_lidar;
+          association = &m;
+        }
+        const bool want_rl = extrinsic && rows[6] != nullptr;
+        const double e = ContinuousPointToPlane::EvaluateAtKnots(
+            *p.pose, *association, parameters, any ? rows : nullptr, want_rl ? &J_tau : nullptr);
+        if (want_rl) {
+          LiftPoseJacobian<1>(Eigen::Matrix<double, 1, 6>(-J_tau), parameters[6], rows[6]);
+        }
+        if (loss_ == nullptr) {
+          residuals[i] = e;
+          continue;
+        }
+        double rho[3];
+        loss_->Evaluate(e * e, rho);
+        if (rho[2] > 0.0) {  // not concave here: no exact constant row (above)
+          concave.store(false, std::memory_order_relaxed);
+          return;
+        }
+        const double scale = std::sqrt(rho[1]);
+        residuals[i] = scale * e;
+        gaps[i] = rho[0] - rho[1] * e * e;
+        if (!any) continue;
         for (int b = 0; b < blocks_; ++b) {
-          rows[b] = jacobians[b] != nullptr ? jacobians[b] + i * kBlockSizes[b] : nullptr;
-          any = any || rows[b] != nullptr;
+          if (rows[b] == nullptr) continue;
+          for (int c = 0; c < kBlockSizes[b]; ++c) rows[b][c] *= scale;
         }
       }
-      const Point& p = points_[i];
-      const PlaneAssociation* association = &p.association;
-      if (extrinsic) {  // as ContinuousPointToPlaneExtrinsic: q = T_rl·q_l, de/dδ_rl = −de/dδT(τ)
-        m = p.association;
-        m.point_robot = T_rl * p.point_lidar;
-        association = &m;
-      }
-      const bool want_rl = extrinsic && rows[6] != nullptr;
-      const double e = ContinuousPointToPlane::EvaluateAtKnots(
-          *p.pose, *association, parameters, any ? rows : nullptr, want_rl ? &J_tau : nullptr);
-      if (want_rl) {
-        LiftPoseJacobian<1>(Eigen::Matrix<double, 1, 6>(-J_tau), parameters[6], rows[6]);
-      }
-      if (loss_ == nullptr) {
-        residuals[i] = e;
-        continue;
-      }
-      double rho[3];
-      loss_->Evaluate(e * e, rho);
-      if (rho[2] > 0.0) return false;  // not concave here: no exact constant row (above)
-      const double scale = std::sqrt(rho[1]);
-      residuals[i] = scale * e;
-      cost_gap += rho[0] - rho[1] * e * e;
-      if (!any) continue;
-      for (int b = 0; b < blocks_; ++b) {
-        if (rows[b] == nullptr) continue;
-        for (int c = 0; c < kBlockSizes[b]; ++c) rows[b][c] *= scale;
-      }
+    };
+    if (row_runner_) {
+      row_runner_(n, evaluate_rows);
+    } else {
+      evaluate_rows(0, n);
     }
+    if (!concave.load(std::memory_order_relaxed)) return false;
     if (loss_ == nullptr) return true;
+    double cost_gap = 0.0;  // Σ ρ(e²) − ρ'(e²)·e², in row order
+    for (const double gap : gaps) cost_gap += gap;
     residuals[n] = std::sqrt(std::max(cost_gap, 0.0));  // clamps rounding below 0 only
     if (jacobians != nullptr) {
       for (int b = 0; b < blocks_; ++b) {
@@ -136,6 +162,7 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
   std::vector<Point> points_;
   std::shared_ptr<const ceres::LossFunction> loss_;
   int blocks_;
+  RowRunner row_runner_;
 };
 
 }  // namespace ctlio

@@ -102,7 +102,9 @@ struct OdometryConfig {
   // motion prior and bias walk go to the interval that holds their time; after the scan the
   // window marginalises down to window_knots − 1 knots as before. 1 = the paper's knot per scan.
   int knots_per_scan = 1;
-  int solver_threads = 1;  // Ceres threads (iterations per round: lidar_frontend.solver_iterations)
+  // window.threads: the solve's interpolations and lidar rows (SlidingWindowOptions::threads);
+  // Ceres evaluates on one thread (iterations per round: lidar_frontend.solver_iterations)
+  int solver_threads = 1;
   // window.overlap: scan k's voxel-map insertion and the marginalisation before scan k+1 run on a
   // second thread, instead of one after the other on the scan thread: the insertion from the
   // moment scan k's pose is estimated (in real time it ends while the robot waits for the next

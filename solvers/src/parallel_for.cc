@@ -1,0 +1,156 @@
+#include "ctlio/solvers/parallel_for.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace ctlio::internal {
+namespace {
+
+inline void CpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+// The process-wide helpers of ParallelFor. One loop at a time; a second caller meanwhile runs its
+// chunks itself (RunOnPool).
+//
+// Chunks are claimed, not assigned: the caller and the helpers take the next unclaimed chunk until
+// none is left, so a helper that is asleep, or not scheduled because the cores are busy, never
+// holds the loop up — the caller then runs its chunks (which chunk runs where changes nothing:
+// the chunks' bounds depend on n and their count only). The caller waits only for chunks a helper
+// has claimed and is running.
+class Pool {
+ public:
+  static Pool& Instance() {
+    static Pool pool;
+    return pool;
+  }
+
+  // false when another loop holds the pool.
+  bool TryRun(size_t chunks, size_t n, const std::function<void(size_t, size_t, size_t)>& f) {
+    std::unique_lock<std::mutex> run(run_mutex_, std::try_to_lock);
+    if (!run.owns_lock()) return false;
+    while (helpers_.size() + 1 < chunks) {
+      helpers_.emplace_back([this] { HelperLoop(); });
+    }
+    task_ = &f;
+    chunks_ = chunks;
+    n_ = n;
+    errors_.assign(chunks, nullptr);
+    done_.store(0, std::memory_order_relaxed);
+    {
+      std::lock_guard<std::mutex> lock(wake_mutex_);
+      ++generation_;
+      // A new generation with no chunk claimed yet; publishes the fields above.
+      ticket_.store(generation_ << 32, std::memory_order_release);
+    }
+    wake_.notify_all();
+    RunChunks(generation_);
+    // Chunks claimed by helpers are running: wait for them (short), yielding if it is not.
+    for (int i = 0; done_.load(std::memory_order_acquire) != chunks; ++i) {
+      if (i < 4096) {
+        CpuRelax();
+      } else {
+        std::this_thread::yield();
+      }
+    }
+    task_ = nullptr;
+    for (const std::exception_ptr& e : errors_) {
+      if (e) std::rethrow_exception(e);
+    }
+    return true;
+  }
+
+  ~Pool() {
+    {
+      std::lock_guard<std::mutex> lock(wake_mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : helpers_) t.join();
+  }
+
+ private:
+  Pool() = default;
+
+  // Claims and runs the chunks of loop `generation` until none is left.
+  void RunChunks(uint64_t generation) {
+    for (;;) {
+      uint64_t ticket = ticket_.load(std::memory_order_acquire);
+      size_t c;
+      do {
+        if ((ticket >> 32) != generation) return;  // that loop is over
+        c = static_cast<size_t>(ticket & 0xffffffffu);
+        if (c >= chunks_) return;
+      } while (!ticket_.compare_exchange_weak(ticket, ticket + 1, std::memory_order_acq_rel,
+                                              std::memory_order_acquire));
+      // Claimed: the loop's fields stay as they are until every chunk is done.
+      try {
+        (*task_)(c, c * n_ / chunks_, (c + 1) * n_ / chunks_);
+      } catch (...) {
+        errors_[c] = std::current_exception();
+      }
+      done_.fetch_add(1, std::memory_order_acq_rel);
+    }
+  }
+
+  void HelperLoop() {
+    uint64_t seen = 0;
+    for (;;) {
+      const uint64_t generation = WaitForLoop(seen);
+      if (generation == 0) return;  // stopping
+      seen = generation;
+      RunChunks(generation);
+    }
+  }
+
+  // The generation of a loop newer than `seen`, polled for up to kSpinMicroseconds, then slept for;
+  // 0 when the pool stops.
+  uint64_t WaitForLoop(uint64_t seen) {
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point deadline = Clock::now() + std::chrono::microseconds(kSpinMicroseconds);
+    for (int i = 0;; ++i) {
+      const uint64_t generation = ticket_.load(std::memory_order_acquire) >> 32;
+      if (generation != seen) return generation;
+      if ((i & 63) == 63 && Clock::now() > deadline) break;
+      CpuRelax();
+    }
+    std::unique_lock<std::mutex> lock(wake_mutex_);
+    wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+    return stop_ ? 0 : generation_;
+  }
+
+  std::mutex run_mutex_;  // held by the loop on the pool
+  std::vector<std::thread> helpers_;
+  const std::function<void(size_t, size_t, size_t)>* task_ = nullptr;
+  size_t chunks_ = 0, n_ = 0;
+  std::vector<std::exception_ptr> errors_;
+  // The current loop's generation (high 32 bits) and its next unclaimed chunk (low 32 bits).
+  std::atomic<uint64_t> ticket_{0};
+  std::atomic<size_t> done_{0};  // chunks of the current loop finished
+  std::mutex wake_mutex_;        // guards generation_ and stop_
+  std::condition_variable wake_;
+  uint64_t generation_ = 0;
+  bool stop_ = false;
+  // ~ the gap between two evaluations of the solve (a linear solve), so the helper stays
+  // polling through a solve and sleeps soon after it.
+  static constexpr int kSpinMicroseconds = 300;
+};
+
+}  // namespace
+
+void RunOnPool(size_t chunks, size_t n, const std::function<void(size_t, size_t, size_t)>& f) {
+  if (Pool::Instance().TryRun(chunks, n, f)) return;
+  for (size_t c = 0; c < chunks; ++c) f(c, c * n / chunks, (c + 1) * n / chunks);
+}
+
+}  // namespace ctlio::internal

@@ -1,0 +1,94 @@
+// ParallelFor (solvers/parallel_for.h): every index runs exactly once, in chunks whose bounds
+// depend on n and the thread count only, whichever thread claims them; a chunk's exception reaches
+// the caller; a loop started while the pool is busy (from another thread, or from inside a chunk)
+// runs on its caller with the same chunks instead of waiting.
+#include "ctlio/solvers/parallel_for.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace ctlio {
+namespace {
+
+// chunk c of n over t threads: [c·n/k, (c+1)·n/k) with k = min(t, n) chunks.
+void ExpectChunks(int threads, size_t n) {
+  const size_t k = std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(threads), n));
+  std::vector<std::atomic<int>> hits(n);
+  std::vector<std::pair<size_t, size_t>> bounds(k, {n + 1, n + 1});
+  ParallelFor(threads, n, [&](size_t c, size_t begin, size_t end) {
+    bounds[c] = {begin, end};
+    for (size_t i = begin; i < end; ++i) hits[i].fetch_add(1);
+  });
+  for (size_t c = 0; c < k && n > 0; ++c) {
+    EXPECT_EQ(bounds[c].first, c * n / k) << threads << " threads, n " << n << ", chunk " << c;
+    EXPECT_EQ(bounds[c].second, (c + 1) * n / k);
+  }
+  for (size_t i = 0; i < n; ++i) EXPECT_EQ(hits[i].load(), 1) << "index " << i;
+}
+
+TEST(ParallelFor, EveryIndexOnceInFixedChunks) {
+  for (const int threads : {1, 2, 3, 4}) {
+    for (const size_t n : {size_t{0}, size_t{1}, size_t{2}, size_t{5}, size_t{1000}}) {
+      ExpectChunks(threads, n);
+    }
+  }
+}
+
+// Thousands of short loops back to back (the solve's pattern: a loop per evaluation) neither lose
+// nor repeat a chunk, whether the helpers are polling or asleep between them.
+TEST(ParallelFor, ManyShortLoops) {
+  std::vector<int> sums;
+  for (int loop = 0; loop < 5000; ++loop) {
+    std::vector<int> part(2, 0);
+    ParallelFor(2, 100, [&](size_t c, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) part[c] += static_cast<int>(i);
+    });
+    ASSERT_EQ(part[0] + part[1], 4950) << "loop " << loop;
+    ASSERT_EQ(part[0], 1225);
+    if (loop % 1000 == 999) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+TEST(ParallelFor, ExceptionOfAnyChunkReachesTheCaller) {
+  for (const size_t bad : {size_t{0}, size_t{1}, size_t{2}}) {
+    EXPECT_THROW(ParallelFor(3, 30,
+                             [&](size_t c, size_t, size_t) {
+                               if (c == bad) throw std::runtime_error("chunk failed");
+                             }),
+                 std::runtime_error)
+        << "chunk " << bad;
+  }
+  ExpectChunks(3, 30);  // the pool still works afterwards
+}
+
+TEST(ParallelFor, NestedAndConcurrentLoopsRunOnTheirCallers) {
+  std::atomic<int> inner{0};
+  ParallelFor(2, 2, [&](size_t, size_t, size_t) {
+    ParallelFor(2, 10, [&](size_t, size_t begin, size_t end) {
+      inner.fetch_add(static_cast<int>(end - begin));
+    });
+  });
+  EXPECT_EQ(inner.load(), 20);
+  std::vector<long> totals(4, 0);
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 4; ++t) {
+    callers.emplace_back([&, t] {
+      for (int loop = 0; loop < 500; ++loop) {
+        std::vector<long> part(2, 0);
+        ParallelFor(2, 1000, [&](size_t c, size_t begin, size_t end) {
+          for (size_t i = begin; i < end; ++i) part[c] += static_cast<long>(i);
+        });
+        totals[t] += part[0] + part[1];
+      }
+    });
+  }
+  for (std::thread& c : callers) c.join();
+  for (int t = 0; t < 4; ++t) EXPECT_EQ(totals[t], 500L * 499500L) << "caller " << t;
+}
+
+}  // namespace
+}  // namespace ctlio
