@@ -43,15 +43,15 @@ class Pool {
       helpers_.emplace_back([this] { HelperLoop(); });
     }
     task_ = &f;
-    chunks_ = chunks;
+    chunks_.store(chunks, std::memory_order_relaxed);
     n_ = n;
     errors_.assign(chunks, nullptr);
     done_.store(0, std::memory_order_relaxed);
     {
       std::lock_guard<std::mutex> lock(wake_mutex_);
-      ++generation_;
+      if (++generation_ == 0) ++generation_;  // 0 stays "no loop yet" through the wrap-around
       // A new generation with no chunk claimed yet; publishes the fields above.
-      ticket_.store(generation_ << 32, std::memory_order_release);
+      ticket_.store(uint64_t{generation_} << 32, std::memory_order_release);
     }
     wake_.notify_all();
     RunChunks(generation_);
@@ -83,19 +83,20 @@ class Pool {
   Pool() = default;
 
   // Claims and runs the chunks of loop `generation` until none is left.
-  void RunChunks(uint64_t generation) {
+  void RunChunks(uint32_t generation) {
     for (;;) {
       uint64_t ticket = ticket_.load(std::memory_order_acquire);
       size_t c;
       do {
         if ((ticket >> 32) != generation) return;  // that loop is over
         c = static_cast<size_t>(ticket & 0xffffffffu);
-        if (c >= chunks_) return;
+        if (c >= chunks_.load(std::memory_order_relaxed)) return;
       } while (!ticket_.compare_exchange_weak(ticket, ticket + 1, std::memory_order_acq_rel,
                                               std::memory_order_acquire));
       // Claimed: the loop's fields stay as they are until every chunk is done.
+      const size_t chunks = chunks_.load(std::memory_order_relaxed);
       try {
-        (*task_)(c, c * n_ / chunks_, (c + 1) * n_ / chunks_);
+        (*task_)(c, c * n_ / chunks, (c + 1) * n_ / chunks);
       } catch (...) {
         errors_[c] = std::current_exception();
       }
@@ -104,42 +105,42 @@ class Pool {
   }
 
   void HelperLoop() {
-    uint64_t seen = 0;
-    for (;;) {
-      const uint64_t generation = WaitForLoop(seen);
-      if (generation == 0) return;  // stopping
-      seen = generation;
-      RunChunks(generation);
-    }
+    uint32_t seen = 0;
+    while (WaitForLoop(&seen)) RunChunks(seen);
   }
 
-  // The generation of a loop newer than `seen`, polled for up to kSpinMicroseconds, then slept for;
-  // 0 when the pool stops.
-  uint64_t WaitForLoop(uint64_t seen) {
+  // Waits for a loop newer than *seen (polling for up to kSpinMicroseconds, then asleep) and sets
+  // *seen to its generation; false when the pool stops.
+  bool WaitForLoop(uint32_t* seen) {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point deadline = Clock::now() + std::chrono::microseconds(kSpinMicroseconds);
     for (int i = 0;; ++i) {
-      const uint64_t generation = ticket_.load(std::memory_order_acquire) >> 32;
-      if (generation != seen) return generation;
+      const auto generation = static_cast<uint32_t>(ticket_.load(std::memory_order_acquire) >> 32);
+      if (generation != *seen) {
+        *seen = generation;
+        return true;
+      }
       if ((i & 63) == 63 && Clock::now() > deadline) break;
       CpuRelax();
     }
     std::unique_lock<std::mutex> lock(wake_mutex_);
-    wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-    return stop_ ? 0 : generation_;
+    wake_.wait(lock, [&] { return stop_ || generation_ != *seen; });
+    *seen = generation_;
+    return !stop_;
   }
 
   std::mutex run_mutex_;  // held by the loop on the pool
   std::vector<std::thread> helpers_;
   const std::function<void(size_t, size_t, size_t)>* task_ = nullptr;
-  size_t chunks_ = 0, n_ = 0;
+  std::atomic<size_t> chunks_{0};  // read before a claim, to see that none is left
+  size_t n_ = 0;
   std::vector<std::exception_ptr> errors_;
   // The current loop's generation (high 32 bits) and its next unclaimed chunk (low 32 bits).
   std::atomic<uint64_t> ticket_{0};
   std::atomic<size_t> done_{0};  // chunks of the current loop finished
   std::mutex wake_mutex_;        // guards generation_ and stop_
   std::condition_variable wake_;
-  uint64_t generation_ = 0;
+  uint32_t generation_ = 0;
   bool stop_ = false;
   // ~ the gap between two evaluations of the solve (a linear solve), so the helper stays
   // polling through a solve and sleeps soon after it.
