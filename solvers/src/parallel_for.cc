@@ -12,6 +12,9 @@
 namespace ctlio::internal {
 namespace {
 
+// Where chunk c of `chunks` chunks of [0, n) begins (chunk c ends where c + 1 begins).
+inline size_t ChunkBegin(size_t c, size_t n, size_t chunks) { return c * n / chunks; }
+
 inline void CpuRelax() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -96,7 +99,7 @@ class Pool {
       // Claimed: the loop's fields stay as they are until every chunk is done.
       const size_t chunks = chunks_.load(std::memory_order_relaxed);
       try {
-        (*task_)(c, c * n_ / chunks, (c + 1) * n_ / chunks);
+        (*task_)(c, ChunkBegin(c, n_, chunks), ChunkBegin(c + 1, n_, chunks));
       } catch (...) {
         errors_[c] = std::current_exception();
       }
@@ -151,7 +154,7 @@ class Pool {
 
 void RunOnPool(size_t chunks, size_t n, const std::function<void(size_t, size_t, size_t)>& f) {
   if (Pool::Instance().TryRun(chunks, n, f)) return;
-  for (size_t c = 0; c < chunks; ++c) f(c, c * n / chunks, (c + 1) * n / chunks);
+  for (size_t c = 0; c < chunks; ++c) f(c, ChunkBegin(c, n, chunks), ChunkBegin(c + 1, n, chunks));
 }
 
 }  // namespace ctlio::internal

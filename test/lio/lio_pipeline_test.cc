@@ -56,10 +56,10 @@ TEST(LioPipeline, SingerLioAndBaselineTrackShortSimulatedSequence) {
 // voxel-plane association tracks the same sequence within the same bound.
 TEST(LioPipeline, FrontendThreadsAndVoxelPlanes) {
   // Singer-LIO only: the baseline runs the same front end (ScanRegistration, PrepareScan).
+  const LioMethod m = LioMethod::kSingerLio;
+  sim::SimulatedSource one_source(ShortSequence());
+  const lioapp::RunSummary one = lioapp::RunOdometry(one_source, Config(m));
   for (const int variant : {0, 1, 2}) {
-    const LioMethod m = LioMethod::kSingerLio;
-    sim::SimulatedSource one_source(ShortSequence());
-    const lioapp::RunSummary one = lioapp::RunOdometry(one_source, Config(m));
     OdometryConfig two_threads = Config(m);
     two_threads.frontend.threads = 2;
     if (variant >= 1) two_threads.solver_threads = 2;
