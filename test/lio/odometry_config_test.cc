@@ -135,6 +135,22 @@ TEST(OdometryConfig, CalibrationSection) {
       "cal_w.yaml", "calibration:\n  estimate_time_offset: true\n  warmup_replay_s: 2\n"));
   EXPECT_TRUE(w.calibration.replays_warmup());
   EXPECT_DOUBLE_EQ(w.calibration.warmup_replay_s, 2.0);
+  EXPECT_EQ(w.calibration.warmup_replay_passes, 1);
+  EXPECT_FALSE(w.calibration.warmup_replay_hold);
+  const OdometryConfig wp = LoadOdometryConfig(
+      WriteTemp("cal_wp.yaml",
+                "calibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 4\n"
+                "  warmup_replay_passes: 2\n  warmup_replay_hold: true\n"));
+  EXPECT_EQ(wp.calibration.warmup_replay_passes, 2);
+  EXPECT_TRUE(wp.calibration.warmup_replay_hold);
+  for (const char* bad_passes : {"0", "11", "1.5"}) {
+    EXPECT_THROW(
+        LoadOdometryConfig(WriteTemp("cal_wpb.yaml", std::string("calibration:\n  "
+                                                                 "warmup_replay_passes: ") +
+                                                         bad_passes + "\n")),
+        std::runtime_error)
+        << bad_passes;
+  }
   const OdometryConfig n =
       LoadOdometryConfig(WriteTemp("cal_wn.yaml", "calibration:\n  warmup_replay_s: 2\n"));
   EXPECT_FALSE(n.calibration.replays_warmup());  // nothing estimated: nothing to replay

@@ -4,6 +4,7 @@
 // from the wrong start: 20 ms clock offset, 3° / 10 cm extrinsic).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/sim_lio.h"
@@ -60,7 +61,21 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   ASSERT_EQ(warm.time_offset_s.size(), 1u);
   ASSERT_EQ(odometry.config().calibration.time_offset_s.size(), 1u);
   EXPECT_EQ(odometry.config().calibration.TimeOffset(0), warm.time_offset_s[0]);
-  EXPECT_TRUE(odometry.config().T_imu_lidar.Matrix().isApprox(warm.T_imu_lidar.Matrix(), 0.0));
+  // The extrinsic starts at the warm-up's estimate along the coordinates the observability check
+  // found observable, at the configured (nominal) value along the others: in calibration.csv's
+  // chart T = Exp([ρ; φ])·T_nominal.
+  ASSERT_EQ(warm.unobservable.size(), 7u);
+  EXPECT_FALSE(warm.unobservable[0]);  // δ: observable after 1 s of medium motion
+  const SE3& nominal = config.T_imu_lidar;
+  const Vec6 xi_warm = (warm.T_imu_lidar * nominal.Inverse()).Log();
+  const Vec6 xi_start = (odometry.config().T_imu_lidar * nominal.Inverse()).Log();
+  int observable = 0;
+  for (int k = 0; k < 6; ++k) {
+    const bool unobservable = warm.unobservable[static_cast<size_t>(1 + k)];
+    observable += unobservable ? 0 : 1;
+    EXPECT_NEAR(xi_start[k], unobservable ? 0.0 : xi_warm[k], 1e-9) << k;
+  }
+  EXPECT_GE(observable, 3);  // the rotation at least
   EXPECT_EQ(odometry.config().calibration.warmup_replay_s, 0.0);
   // Live, δ starts from 0 towards the true 20 ms; replayed, it starts at the warm-up's estimate
   // (which moved past 10 ms), so the replayed second scan is nearer to it than the live one was.
@@ -72,6 +87,104 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   // Later scans are the replayed pipeline's, and every call reaches it.
   EXPECT_GT(odometry.num_marginalizations(), 0);
   EXPECT_TRUE(odometry.initialised());
+}
+
+// Two passes, the last one held (calibration.warmup_replay_passes / warmup_replay_hold): the
+// second pass starts from where the first ended, not from the live estimates, and solves the span
+// with the calibration held at those values; the scans after the span move it again.
+TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
+  sim::SimulatedSource source(WrongStart(1.6));
+  OdometryConfig config = Calibrating(1.0);
+  config.calibration.warmup_replay_passes = 2;
+  config.calibration.warmup_replay_hold = true;
+  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
+  LioOdometry odometry(config);
+  io::ScanFrame frame;
+  int scans = 0, replayed_at = -1;
+  while (source.Next(&frame)) {
+    for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
+    const ScanResult r = odometry.AddScan(lioapp::TakeLidarScan(&frame));
+    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
+    if (r.revised_scans > 0) {
+      replayed_at = scans;
+      EXPECT_NE(r.message.find("2 passes"), std::string::npos) << r.message;
+      EXPECT_NE(r.message.find("held over the span"), std::string::npos) << r.message;
+    }
+    ++scans;
+  }
+  ASSERT_GE(replayed_at, 9);
+  ASSERT_LE(replayed_at + 4, scans);
+  // The carrying-on pipeline started from the first pass's estimates: nearer the true 20 ms
+  // than the live warm-up's last estimate (which its first pass started from).
+  const double live = odometry.warmup_results().back().calibration.time_offset_s.at(0);
+  const double start = odometry.config().calibration.TimeOffset(0);
+  EXPECT_NE(start, live);
+  EXPECT_LT(std::abs(start - 0.020), std::abs(live - 0.020));
+  const SE3& T_start = odometry.config().T_imu_lidar;
+  const std::vector<ScanResult>& results = odometry.results();
+  ASSERT_EQ(results.size(), static_cast<size_t>(scans));
+  for (int i = 1; i <= replayed_at; ++i) {
+    const ScanResult::CalibrationEstimate& c = results[static_cast<size_t>(i)].calibration;
+    ASSERT_EQ(c.held.size(), 7u) << "scan " << i;  // δ_0, ρ_xyz, φ_xyz
+    for (const bool h : c.held) EXPECT_TRUE(h) << "scan " << i;
+    // σ_hold = σ_prior / 1e4: 3 µs, 20 µm, 0.03 mdeg.
+    EXPECT_NEAR(c.time_offset_s.at(0), start, 1e-5) << "scan " << i;
+    EXPECT_LT((c.T_imu_lidar.translation() - T_start.translation()).norm(), 1e-4) << "scan " << i;
+    EXPECT_LT((c.T_imu_lidar * T_start.Inverse()).Log().tail<3>().norm(), 1e-5) << "scan " << i;
+  }
+  double moved = 0.0;
+  for (size_t i = static_cast<size_t>(replayed_at) + 1; i < results.size(); ++i) {
+    EXPECT_TRUE(results[i].calibration.held.empty()) << "scan " << i;
+    moved = std::max(moved, std::abs(results[i].calibration.time_offset_s.at(0) - start));
+  }
+  EXPECT_GT(moved, 1e-5);  // released: the data move it again
+}
+
+// Slow motion (translation only, tuning sequence slow/100): the observability check finds the
+// lever arm unobservable, so its estimate after the warm-up is drift. The replay then starts
+// those coordinates from the configured (nominal) value and does not hold them; it holds the
+// others.
+TEST(WarmupReplay, UnobservableCoordinatesStartFromTheConfigAndAreNotHeld) {
+  sim::SimulatedSource source(testing::WrongCalibrationSequence(sim::Regime::kSlow, 1.6, 0.020));
+  OdometryConfig config = Calibrating(1.0);
+  config.calibration.warmup_replay_passes = 2;
+  config.calibration.warmup_replay_hold = true;
+  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
+  const SE3 nominal = config.T_imu_lidar;
+  LioOdometry odometry(config);
+  io::ScanFrame frame;
+  int scans = 0, replayed_at = -1;
+  while (source.Next(&frame)) {
+    for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
+    const ScanResult r = odometry.AddScan(lioapp::TakeLidarScan(&frame));
+    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
+    if (r.revised_scans > 0) replayed_at = scans;
+    ++scans;
+  }
+  ASSERT_GE(replayed_at, 9);
+  // Which coordinates the last pass held: the same on every scan of the span.
+  const std::vector<bool> held = odometry.results()[1].calibration.held;
+  ASSERT_EQ(held.size(), 7u);
+  for (int i = 2; i <= replayed_at; ++i) {
+    EXPECT_EQ(odometry.results()[static_cast<size_t>(i)].calibration.held, held) << "scan " << i;
+  }
+  EXPECT_FALSE(held[1] && held[2] && held[3]) << "the lever arm is not observable here";
+  // Not held = unobservable when the pass started = started at the nominal value.
+  const Vec6 xi_start = (odometry.config().T_imu_lidar * nominal.Inverse()).Log();
+  const Vec6 xi_end =
+      (odometry.results()[static_cast<size_t>(replayed_at)].calibration.T_imu_lidar *
+       nominal.Inverse())
+          .Log();
+  int free = 0;
+  for (int k = 0; k < 6; ++k) {
+    if (held[static_cast<size_t>(1 + k)]) {
+      EXPECT_NEAR(xi_end[k], xi_start[k], 1e-4) << k;  // held over the span
+    } else {
+      ++free;
+      EXPECT_NEAR(xi_start[k], 0.0, 1e-9) << k;
+    }
+  }
+  EXPECT_GE(free, 1);
 }
 
 // RunOdometry's two trajectories: the reported one takes the replayed estimates of the warm-up

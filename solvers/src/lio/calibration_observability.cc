@@ -11,21 +11,18 @@ namespace ctlio::lio {
 CalibrationObservability::CalibrationObservability(const CalibrationOptions& options,
                                                    int num_time_offsets, bool extrinsic)
     : options_(options) {
-  std::vector<double> sigma;
+  const std::vector<double> sigma = options.PriorSigmas(num_time_offsets, extrinsic);
   for (int j = 0; j < num_time_offsets; ++j) {
     names_.push_back("time_offset_" + std::to_string(j));
-    sigma.push_back(options.time_offset_prior_sigma_s);
     threshold_.push_back(options.time_offset_observability_threshold);
   }
   if (extrinsic) {
     for (const char* a : {"x", "y", "z"}) {
       names_.push_back(std::string("extrinsic_rho_") + a);
-      sigma.push_back(options.extrinsic_prior_sigma_m);
       threshold_.push_back(options.translation_observability_threshold);
     }
     for (const char* a : {"x", "y", "z"}) {
       names_.push_back(std::string("extrinsic_phi_") + a);
-      sigma.push_back(options.extrinsic_prior_sigma_deg * M_PI / 180.0);
       threshold_.push_back(options.rotation_observability_threshold);
     }
   }

@@ -34,6 +34,17 @@ void CalibrationOptions::Validate() const {
   // Beyond a minute the kept raw scans (≈ 7 MB per full-resolution 128-beam sweep) dominate.
   require(std::isfinite(warmup_replay_s) && warmup_replay_s >= 0 && warmup_replay_s <= 60,
           "calibration.warmup_replay_s must be in [0, 60] s (0: no replay)");
+  require(warmup_replay_passes >= 1 && warmup_replay_passes <= 10,
+          "calibration.warmup_replay_passes must be in [1, 10]");
+}
+
+std::vector<double> CalibrationOptions::PriorSigmas(int num_time_offsets, bool extrinsic) const {
+  std::vector<double> sigma(static_cast<std::size_t>(num_time_offsets), time_offset_prior_sigma_s);
+  if (extrinsic) {
+    sigma.insert(sigma.end(), 3, extrinsic_prior_sigma_m);
+    sigma.insert(sigma.end(), 3, extrinsic_prior_sigma_deg * M_PI / 180.0);
+  }
+  return sigma;
 }
 
 }  // namespace ctlio::lio

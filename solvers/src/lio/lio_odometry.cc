@@ -146,26 +146,30 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   }
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMs();
-  // The estimates after this scan become the replay's start values and prior means; the
-  // configured σ stays (the replay uses the same data again, so it must not also be told it
-  // is sure of them).
-  OdometryConfig replay_config = config_;
-  CalibrationOptions& cal = replay_config.calibration;
-  cal.warmup_replay_s = 0.0;
-  if (cal.estimate_time_offset && !result->calibration.time_offset_s.empty()) {
-    cal.time_offset_s = result->calibration.time_offset_s;
-  }
-  if (cal.estimate_extrinsic && result->calibration.has_extrinsic) {
-    replay_config.T_imu_lidar = result->calibration.T_imu_lidar;
-  }
-  auto replay = std::make_unique<LioOdometry>(replay_config);
-  size_t next_imu = 0;
+  // Each pass starts from the estimates the one before ended with (the live ones for the first).
+  const int passes = config_.calibration.warmup_replay_passes;
+  std::unique_ptr<LioOdometry> replay;
   ScanResult replayed;
-  for (const auto& [scan, imu_before] : warmup_scans_) {
-    for (; next_imu < imu_before; ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
-    replayed = replay->AddScan(scan);
+  ScanResult::CalibrationEstimate start_values = result->calibration;
+  for (int pass = 0; pass < passes; ++pass) {
+    const bool last = pass == passes - 1;
+    replay = std::make_unique<LioOdometry>(ReplayConfig(start_values));
+    if (last && config_.calibration.warmup_replay_hold) {
+      // The replay's clock starts at the first kept scan's begin, so its scans end within span.
+      replay->hold_calibration_until_s_ = span;
+      replay->hold_mask_ = start_values.unobservable;
+      replay->hold_mask_.flip();  // the observable coordinates; empty (no check): all
+    }
+    size_t next_imu = 0;
+    for (const auto& [scan, imu_before] : warmup_scans_) {
+      for (; next_imu < imu_before; ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
+      replayed = replay->AddScan(scan);
+    }
+    for (; next_imu < warmup_imu_.size(); ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
+    // A pass that ends without an estimate is the one that carries on: nothing to start from.
+    if (replayed.status == ScanStatus::kFailed || !replay->initialised()) break;
+    start_values = replayed.calibration;
   }
-  for (; next_imu < warmup_imu_.size(); ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
   // This call's cost is the live scan's and the whole replay's.
   replayed.revised_scans = static_cast<int>(warmup_scans_.size()) - 1;
   replayed.milliseconds = result->milliseconds + MsSince(start);
@@ -173,6 +177,8 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   std::ostringstream note;
   note << "calibration warm-up replayed: " << warmup_scans_.size() << " scans over " << span
        << " s processed again from the estimates after this scan";
+  if (passes > 1) note << " (" << passes << " passes, each from the previous one's estimates)";
+  if (config_.calibration.warmup_replay_hold) note << ", the calibration held over the span";
   AddNote(&replayed, note.str());
   replay->results_.back() = replayed;
   warmup_results_ = std::move(results_);
@@ -181,6 +187,35 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   warmup_imu_ = {};
   replay_ = std::move(replay);
   *result = replayed;
+}
+
+OdometryConfig LioOdometry::ReplayConfig(const ScanResult::CalibrationEstimate& estimate) const {
+  // The estimates become the replay's start values and prior means; the configured σ stays (the
+  // replay uses the same data again, so it must not also be told it is sure of them). A
+  // coordinate the observability check left unobservable starts from its configured value
+  // instead: its estimate is drift, and passes started from drift would add it up.
+  OdometryConfig replay = config_;
+  CalibrationOptions& cal = replay.calibration;
+  cal.warmup_replay_s = 0.0;
+  const std::vector<bool>& unobservable = estimate.unobservable;
+  auto observable = [&](size_t i) { return i >= unobservable.size() || !unobservable[i]; };
+  const size_t offsets = estimate.time_offset_s.size();
+  if (cal.estimate_time_offset && offsets > 0) {
+    cal.time_offset_s.resize(offsets);
+    for (size_t j = 0; j < offsets; ++j) {
+      cal.time_offset_s[j] = observable(j) ? estimate.time_offset_s[j]
+                                           : config_.calibration.TimeOffset(static_cast<int>(j));
+    }
+  }
+  if (cal.estimate_extrinsic && estimate.has_extrinsic) {
+    // The coordinates of the report (calibration.csv): T = Exp([ρ; φ])·T_configured.
+    Vec6 xi = (estimate.T_imu_lidar * config_.T_imu_lidar.Inverse()).Log();
+    for (size_t k = 0; k < 6; ++k) {
+      if (!observable(offsets + k)) xi[static_cast<Eigen::Index>(k)] = 0.0;
+    }
+    replay.T_imu_lidar = SE3::Exp(xi) * config_.T_imu_lidar;
+  }
+  return replay;
 }
 
 ScanResult LioOdometry::RunScan(const LidarScan& input) {
@@ -289,7 +324,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const SE3 predicted = window_.Pose(estimator_->NewestPoseKey());
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
-  HoldUnobservableCalibration(result);
+  HoldCalibration(scan.t_end, result);
   const RegistrationSummary registered =
       registration_.Register(frontend_.map(), lidar.get(), &window_);
   ReleaseCalibration();
@@ -362,18 +397,32 @@ bool LioOdometry::StartObservability() {
   return true;
 }
 
-void LioOdometry::HoldUnobservableCalibration(ScanResult* result) {
-  // Before any assessment everything is unobservable (nothing measured yet): held too.
-  if (!config_.calibration.any() || !config_.calibration.hold_unobservable ||
-      !StartObservability()) {
+void LioOdometry::HoldCalibration(double t_end, ScanResult* result) {
+  const CalibrationOptions& cal = config_.calibration;
+  if (!cal.any()) return;
+  std::vector<bool> hold;
+  Eigen::VectorXd sigma;
+  if (t_end <= hold_calibration_until_s_ + 1e-6) {
+    // The last pass of a warm-up replay over its span (calibration.warmup_replay_hold).
+    const std::vector<StateId> states = CalibrationStates();
+    const bool extrinsic = !states.empty() && states.back() == kExtrinsicKey;
+    const std::vector<double> prior =
+        cal.PriorSigmas(static_cast<int>(states.size()) - (extrinsic ? 1 : 0), extrinsic);
+    hold.assign(prior.size(), true);
+    for (size_t i = 0; i < hold_mask_.size() && i < hold.size(); ++i) hold[i] = hold_mask_[i];
+    sigma =
+        Eigen::Map<const Eigen::VectorXd>(prior.data(), static_cast<Eigen::Index>(prior.size()));
+  } else if (cal.hold_unobservable && StartObservability()) {
+    // Before any assessment everything is unobservable (nothing measured yet): held too.
+    hold = observability_->Unobservable();
+    sigma = observability_->prior_sigma();
+  } else {
     return;
   }
-  const std::vector<bool> hold = observability_->Unobservable();
   result->calibration.held = hold;
-  // A prior at the current value along each unobservable coordinate, σ_hold = σ_prior/√w: the
+  // A prior at the current value along each held coordinate, σ_hold = σ_prior/√w: the
   // solve moves it by a negligible amount; removed again before anything else reads the window.
-  const double w = std::sqrt(config_.calibration.hold_information);
-  const Eigen::VectorXd& sigma = observability_->prior_sigma();
+  const double w = std::sqrt(cal.hold_information);
   int i = 0;
   for (const StateId id : CalibrationStates()) {
     if (id == kExtrinsicKey) {

@@ -242,7 +242,9 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
             SetFromYaml(&o.translation_observability_threshold)},
            {"hold_unobservable", SetFromYaml(&o.hold_unobservable)},
            {"hold_information", SetFromYaml(&o.hold_information)},
-           {"warmup_replay_s", SetFromYaml(&o.warmup_replay_s)}});
+           {"warmup_replay_s", SetFromYaml(&o.warmup_replay_s)},
+           {"warmup_replay_passes", SetFromYaml(&o.warmup_replay_passes)},
+           {"warmup_replay_hold", SetFromYaml(&o.warmup_replay_hold)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

@@ -51,22 +51,41 @@ struct CalibrationOptions {
   // Warm-up replay: the first `warmup_replay_s` seconds of data (from the first scan's start) are
   // kept, and when a scan ends past that span they are processed again from the start by a fresh
   // pipeline whose start values and prior means are the estimates after that scan (configured
-  // σ unchanged); that pipeline carries on. Why: with the calibration wrong, the first scans'
-  // estimates (a sparse map, the motion's onset) let the calibration states swing (10° and
-  // 0.6 m within 0.5 s on the tuning runs) and the map and the marginal priors built on them
-  // stay. The scan that triggers it returns with ScanResult::revised_scans > 0 (results() then
-  // holds the replayed estimates of the earlier scans; warmup_results() keeps the ones returned
-  // live). Costs one processing of the span at that scan (a latency spike) and the memory of its
-  // raw scans. 0 = off (no data kept), the default: on the 10 reported sequences (README "Online
-  // calibration") 2 s brought the medium regime's ATE from 1.8× to 1.3× the true values' and made
-  // the fast regime's worse (2.8 vs 2.1 cm), as on the tuning sequences 100–103.
+  // σ unchanged; a coordinate the observability check reports unobservable then starts from its
+  // configured value, its estimate being drift); that pipeline carries on. Why: with the
+  // calibration wrong, the first scans' estimates (a sparse map, the motion's onset) let the
+  // calibration states swing (10° and 0.6 m within 0.5 s on the tuning runs) and the map and the
+  // marginal priors built on them stay. The scan that triggers it returns with
+  // ScanResult::revised_scans > 0 (results() then holds the replayed estimates of the earlier
+  // scans; warmup_results() keeps the ones returned live). Costs one processing of the span at that
+  // scan (a latency spike) and the memory of its raw scans. 0 = off (no data kept), the default: on
+  // the 10 reported sequences (README "Online calibration") 2 s brought the medium regime's ATE
+  // from 1.8× to 1.3× the true values' and made the fast regime's worse (2.8 vs 2.1 cm), as on the
+  // tuning sequences 100–103.
   double warmup_replay_s = 0.0;
+  // Passes of the replay: pass p + 1 processes the span again from the estimates pass p ended
+  // with (start values and prior means, σ unchanged), and the last pass carries on. Why: the
+  // live warm-up's estimates can be farther off than the configured start (the states swing in
+  // the first second: 40° and 0.7 m on tuning run fast/100 with two knots per sweep), and a
+  // pass started from them swings again; each pass costs one processing of the span.
+  int warmup_replay_passes = 1;
+  // The last pass holds the calibration coordinates that were observable when it started (all of
+  // them with observability_horizon_scans = 0) over the replayed span at the values it starts
+  // from (a prior of whitened information hold_information, as hold_unobservable), and releases
+  // them with the first scan after it. Why: even started near the truth, the start-up
+  // (a sparse one-scan map, the motion's onset) moves the calibration states by several degrees
+  // and centimetres, and the map built then stays in use; held, the span is processed as with
+  // known values. With one pass it holds the live estimates (worse: README "Online calibration").
+  bool warmup_replay_hold = false;
 
   // δ_j's configured value (0 when the list is empty).
   double TimeOffset(int j) const {
     return time_offset_s.empty() ? 0.0 : time_offset_s[static_cast<std::size_t>(j)];
   }
   bool any() const { return estimate_time_offset || estimate_extrinsic; }
+  // The prior σ per calibration coordinate in the window's order: δ_j for j < num_time_offsets
+  // [s], then with the extrinsic ρ_xyz [m] and φ_xyz [rad].
+  std::vector<double> PriorSigmas(int num_time_offsets, bool extrinsic) const;
   bool replays_warmup() const { return any() && warmup_replay_s > 0.0; }
 
   void Validate() const;  // throws std::invalid_argument naming the field

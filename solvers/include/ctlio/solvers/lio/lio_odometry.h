@@ -84,6 +84,8 @@ class LioOdometry {
   // processes it again in replay_ from the estimates in `result` and replaces `result` with the
   // replay's; gives up (note, data dropped) if twice the span passes without an estimate.
   void MaybeReplayWarmup(ScanResult* result);
+  // The config of a replay pass started from `estimate` (calibration.warmup_replay_s).
+  OdometryConfig ReplayConfig(const ScanResult::CalibrationEstimate& estimate) const;
   void CheckScan(const LidarScan& scan) const;
   // Input gate: the points timed outside [interval start − tolerance, end + tolerance]
   // (config.input.scan_time_tolerance; the interval starts at the previous scan's end once
@@ -129,9 +131,10 @@ class LioOdometry {
   // (calibration_observability.h), ν and the unobservable ones into result->calibration.
   void AssessCalibrationObservability(ScanResult* result);
   // Before the registration: a strong prior at the current value along every coordinate the
-  // previous scan left unobservable (calibration.hold_unobservable), so that the solve does not
-  // move it; ReleaseCalibration removes them after the solve.
-  void HoldUnobservableCalibration(ScanResult* result);
+  // previous scan left unobservable (calibration.hold_unobservable), or along all of them when
+  // the scan ends (t_end: seconds since the first scan began) within hold_calibration_until_s_,
+  // so that the solve does not move it; ReleaseCalibration removes them after the solve.
+  void HoldCalibration(double t_end, ScanResult* result);
   void ReleaseCalibration();
   // The calibration states the estimator keeps in the window (the baseline has none), in the
   // order of the coordinates: the clock offsets (1-D each), then the extrinsic T_imu_lidar.
@@ -190,6 +193,10 @@ class LioOdometry {
   std::unique_ptr<LioOdometry> replay_;
   std::vector<ScanResult> warmup_results_;
   bool warmup_done_ = false;
+  // Set on the last pass of a held warm-up replay (calibration.warmup_replay_hold): the span,
+  // and which coordinates to hold (those observable when the pass started; empty: all).
+  double hold_calibration_until_s_ = -1.0;
+  std::vector<bool> hold_mask_;
   // The running map insertion (StartMapInsertion). Last: destroyed first, which waits for it
   // while the map and the points it reads still exist.
   std::future<double> map_insertion_;
