@@ -89,12 +89,18 @@ TEST(CalibrationObservability, RejectsAMatrixOfTheWrongSize) {
 
 // Both calibrations from the wrong start (20 ms clock offset; 3° / 10 cm extrinsic) on sequence
 // `regime`/100 for `duration_s`, the observability check at its defaults.
-lioapp::RunSummary RunBoth(sim::Regime regime, double duration_s) {
+lioapp::RunSummary RunBoth(sim::Regime regime, double duration_s, bool two_knots = false) {
   const sim::SimConfig c = testing::WrongCalibrationSequence(regime, duration_s, 0.020);
   OdometryConfig config = testing::SimLioConfig();
   config.calibration.estimate_time_offset = true;
   config.calibration.estimate_extrinsic = true;
-  config.calibration.hold_unobservable = true;  // off by default; the slow test checks the hold
+  if (two_knots) {
+    // The calibration runs' configuration (README "Online calibration"), not held: δ moves.
+    config.knots_per_scan = 2;
+    config.accel_variance = 0.16;
+  } else {
+    config.calibration.hold_unobservable = true;  // off by default; the slow test checks the hold
+  }
   sim::SimulatedSource source(c);
   return lioapp::RunOdometry(source, config);
 }
@@ -129,6 +135,21 @@ TEST(CalibrationObservability, SlowRegimeLeavesTheOffsetAndTheLeverArmUnobservab
   EXPECT_GT(held, static_cast<int>(run.scans.size()) / 2);
   ASSERT_EQ(c.time_offset_s.size(), 1u);
   EXPECT_LT(std::abs(c.time_offset_s[0]), 1e-4);
+}
+
+// With two knots per sweep the slow regime's δ gathers more ν than with one (it moves, unheld, to
+// tens of ms off with a σ of ~1 ms), but stays below the threshold; medium's stays above.
+TEST(CalibrationObservability, TwoKnotsPerSweepSlowOffsetStaysUnobservable) {
+  const lioapp::RunSummary slow = RunBoth(sim::Regime::kSlow, 3.0, true);
+  const lioapp::RunSummary medium = RunBoth(sim::Regime::kMedium, 3.0, true);
+  const CalibrationOptions defaults;
+  const ScanResult& s = Last(slow);
+  const ScanResult& m = Last(medium);
+  ASSERT_EQ(s.calibration.observability.size(), 7u);
+  ASSERT_EQ(m.calibration.observability.size(), 7u);
+  EXPECT_TRUE(s.calibration.unobservable[0]) << "ν = " << s.calibration.observability[0];
+  EXPECT_FALSE(m.calibration.unobservable[0]) << "ν = " << m.calibration.observability[0];
+  EXPECT_GT(m.calibration.observability[0], 10.0 * s.calibration.observability[0]);
 }
 
 TEST(CalibrationObservability, MediumRegimeObservesTheOffsetAndTheLeverArm) {

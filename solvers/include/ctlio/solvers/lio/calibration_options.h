@@ -37,9 +37,11 @@ struct CalibrationOptions {
   // (slow / medium): δ 0.05 / 40, φ ≤ 8e-5 / ≥ 0.5, ρ ≤ 3e-7 / ≥ 1e-3 — one scan of 0.1 s with
   // its knots free says little about the lever arm even with rotation, so the kinds differ by
   // orders of magnitude; each threshold sits between the two regimes' horizon values (README
-  // "Online calibration").
+  // "Online calibration"). δ's threshold was 10 until two knots per sweep (knots_per_scan 2,
+  // accel_variance 0.16) gave slow/100–101 ν = 28–31 over the horizon with δ 19–25 ms off, where
+  // medium/100–103 give ≥ 820 (one knot: ~1 / ~800); 100 sits between both.
   int observability_horizon_scans = 20;
-  double time_offset_observability_threshold = 10.0;
+  double time_offset_observability_threshold = 100.0;
   double rotation_observability_threshold = 0.1;
   double translation_observability_threshold = 1e-3;
   // Off by default: on the joint runs (README "Online calibration") holding cost ATE in every
