@@ -38,15 +38,15 @@ class Pool {
     return pool;
   }
 
-  // false when another loop holds the pool.
+  // false when another loop holds the pool (or the loop has more chunks than a ticket counts).
   bool TryRun(size_t chunks, size_t n, const std::function<void(size_t, size_t, size_t)>& f) {
+    if (chunks > kMaxChunks) return false;
     std::unique_lock<std::mutex> run(run_mutex_, std::try_to_lock);
     if (!run.owns_lock()) return false;
     while (helpers_.size() + 1 < chunks) {
       helpers_.emplace_back([this] { HelperLoop(); });
     }
     task_ = &f;
-    chunks_.store(chunks, std::memory_order_relaxed);
     n_ = n;
     errors_.assign(chunks, nullptr);
     done_.store(0, std::memory_order_relaxed);
@@ -54,7 +54,7 @@ class Pool {
       std::lock_guard<std::mutex> lock(wake_mutex_);
       if (++generation_ == 0) ++generation_;  // 0 stays "no loop yet" through the wrap-around
       // A new generation with no chunk claimed yet; publishes the fields above.
-      ticket_.store(uint64_t{generation_} << 32, std::memory_order_release);
+      ticket_.store(Ticket(generation_, chunks, 0), std::memory_order_release);
     }
     wake_.notify_all();
     RunChunks(generation_);
@@ -85,19 +85,29 @@ class Pool {
  private:
   Pool() = default;
 
+  // The ticket word: the loop's generation (bits 32-63), its chunk count (16-31) and its next
+  // unclaimed chunk (0-15). The count travels with the generation so that a helper holding a
+  // ticket of a finished loop never compares it with the next loop's count: such a ticket has
+  // every chunk claimed, and a claim succeeds only on the current word.
+  static constexpr size_t kMaxChunks = 0xffff;
+  static uint64_t Ticket(uint32_t generation, size_t chunks, size_t next) {
+    return uint64_t{generation} << 32 | uint64_t{chunks} << 16 | uint64_t{next};
+  }
+
   // Claims and runs the chunks of loop `generation` until none is left.
   void RunChunks(uint32_t generation) {
     for (;;) {
       uint64_t ticket = ticket_.load(std::memory_order_acquire);
-      size_t c;
+      size_t c, chunks;
       do {
         if ((ticket >> 32) != generation) return;  // that loop is over
-        c = static_cast<size_t>(ticket & 0xffffffffu);
-        if (c >= chunks_.load(std::memory_order_relaxed)) return;
+        chunks = static_cast<size_t>((ticket >> 16) & kMaxChunks);
+        c = static_cast<size_t>(ticket & kMaxChunks);
+        if (c >= chunks) return;
       } while (!ticket_.compare_exchange_weak(ticket, ticket + 1, std::memory_order_acq_rel,
                                               std::memory_order_acquire));
-      // Claimed: the loop's fields stay as they are until every chunk is done.
-      const size_t chunks = chunks_.load(std::memory_order_relaxed);
+      // Claimed (the acquire sees the fields the loop published); they stay as they are until
+      // every chunk is done.
       try {
         (*task_)(c, ChunkBegin(c, n_, chunks), ChunkBegin(c + 1, n_, chunks));
       } catch (...) {
@@ -135,13 +145,11 @@ class Pool {
   std::mutex run_mutex_;  // held by the loop on the pool
   std::vector<std::thread> helpers_;
   const std::function<void(size_t, size_t, size_t)>* task_ = nullptr;
-  std::atomic<size_t> chunks_{0};  // read before a claim, to see that none is left
   size_t n_ = 0;
   std::vector<std::exception_ptr> errors_;
-  // The current loop's generation (high 32 bits) and its next unclaimed chunk (low 32 bits).
-  std::atomic<uint64_t> ticket_{0};
-  std::atomic<size_t> done_{0};  // chunks of the current loop finished
-  std::mutex wake_mutex_;        // guards generation_ and stop_
+  std::atomic<uint64_t> ticket_{0};  // Ticket(generation, chunks, next unclaimed chunk)
+  std::atomic<size_t> done_{0};      // chunks of the current loop finished
+  std::mutex wake_mutex_;            // guards generation_ and stop_
   std::condition_variable wake_;
   uint32_t generation_ = 0;
   bool stop_ = false;

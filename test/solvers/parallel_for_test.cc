@@ -53,6 +53,22 @@ TEST(ParallelFor, ManyShortLoops) {
   }
 }
 
+// Loops whose chunk counts change from one to the next (1, 4, 2, 3, ...): a helper still holding
+// the previous loop's ticket must not claim a chunk of the next one, which would run that chunk
+// twice (or return before a chunk ended). What ThreadSanitizer caught once under load, before the
+// chunk count travelled in the ticket with the generation.
+TEST(ParallelFor, LoopsOfChangingChunkCountsRunEachChunkOnce) {
+  constexpr int kCounts[] = {1, 4, 2, 3, 1, 3, 4, 2};
+  for (int loop = 0; loop < 20000; ++loop) {
+    const int threads = kCounts[loop % 8];
+    std::vector<int> runs(static_cast<size_t>(threads), 0);
+    ParallelFor(threads, 8, [&](size_t c, size_t, size_t) { ++runs[c]; });
+    for (int c = 0; c < threads; ++c) {
+      ASSERT_EQ(runs[static_cast<size_t>(c)], 1) << "loop " << loop << ", chunk " << c;
+    }
+  }
+}
+
 TEST(ParallelFor, ExceptionOfAnyChunkReachesTheCaller) {
   for (const size_t bad : {size_t{0}, size_t{1}, size_t{2}}) {
     EXPECT_THROW(ParallelFor(3, 30,
