@@ -153,8 +153,11 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   ScanResult::CalibrationEstimate start_values = result->calibration;
   for (int pass = 0; pass < passes; ++pass) {
     const bool last = pass == passes - 1;
-    replay = std::make_unique<LioOdometry>(ReplayConfig(start_values));
-    if (last && config_.calibration.warmup_replay_hold) {
+    OdometryConfig replay_config = ReplayConfig(start_values);
+    const bool hold = last && config_.calibration.warmup_replay_hold;
+    if (hold) replay_config.calibration.hold_gravity = true;
+    replay = std::make_unique<LioOdometry>(replay_config);
+    if (hold) {
       // The replay's clock starts at the first kept scan's begin, so its scans end within span.
       replay->hold_calibration_until_s_ = span;
       replay->hold_mask_ = start_values.unobservable;

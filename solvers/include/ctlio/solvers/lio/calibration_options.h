@@ -79,6 +79,10 @@ struct CalibrationOptions {
   // and centimetres, and the map built then stays in use; held, the span is processed as with
   // known values. With one pass it holds the live estimates (worse: README "Online calibration").
   bool warmup_replay_hold = false;
+  // Set by the held pass of a warm-up replay, not read from YAML: C_mi stays held (as with
+  // window.estimate_gravity false and no extrinsic estimated) although the extrinsic is
+  // estimated, its first scan being placed with start values the warm-up produced.
+  bool hold_gravity = false;
 
   // δ_j's configured value (0 when the list is empty).
   double TimeOffset(int j) const {
