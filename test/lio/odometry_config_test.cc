@@ -143,12 +143,20 @@ TEST(OdometryConfig, CalibrationSection) {
                 "  warmup_replay_passes: 2\n  warmup_replay_hold: true\n"));
   EXPECT_EQ(wp.calibration.warmup_replay_passes, 2);
   EXPECT_TRUE(wp.calibration.warmup_replay_hold);
+  for (const char* without_span : {"warmup_replay_passes: 2", "warmup_replay_hold: true"}) {
+    EXPECT_THROW(LoadOdometryConfig(
+                     WriteTemp("cal_wps.yaml", std::string("calibration:\n  estimate_extrinsic: "
+                                                           "true\n  ") +
+                                                   without_span + "\n")),
+                 std::runtime_error)
+        << without_span;
+  }
   for (const char* bad_passes : {"0", "11", "1.5"}) {
-    EXPECT_THROW(
-        LoadOdometryConfig(WriteTemp("cal_wpb.yaml", std::string("calibration:\n  "
-                                                                 "warmup_replay_passes: ") +
-                                                         bad_passes + "\n")),
-        std::runtime_error)
+    EXPECT_THROW(LoadOdometryConfig(
+                     WriteTemp("cal_wpb.yaml", std::string("calibration:\n  warmup_replay_s: 1\n"
+                                                           "  warmup_replay_passes: ") +
+                                                   bad_passes + "\n")),
+                 std::runtime_error)
         << bad_passes;
   }
   const OdometryConfig n =

@@ -36,6 +36,9 @@ void CalibrationOptions::Validate() const {
           "calibration.warmup_replay_s must be in [0, 60] s (0: no replay)");
   require(warmup_replay_passes >= 1 && warmup_replay_passes <= 10,
           "calibration.warmup_replay_passes must be in [1, 10]");
+  // Without a replay span they would do nothing: say so rather than run without them.
+  require(warmup_replay_s > 0 || (warmup_replay_passes == 1 && !warmup_replay_hold),
+          "calibration.warmup_replay_passes / warmup_replay_hold need warmup_replay_s > 0");
 }
 
 std::vector<double> CalibrationOptions::PriorSigmas(int num_time_offsets, bool extrinsic) const {

@@ -199,7 +199,9 @@ OdometryConfig LioOdometry::ReplayConfig(const ScanResult::CalibrationEstimate& 
   // instead: its estimate is drift, and passes started from drift would add it up.
   OdometryConfig replay = config_;
   CalibrationOptions& cal = replay.calibration;
-  cal.warmup_replay_s = 0.0;
+  cal.warmup_replay_s = 0.0;  // the replay does not replay
+  cal.warmup_replay_passes = 1;
+  cal.warmup_replay_hold = false;
   const std::vector<bool>& unobservable = estimate.unobservable;
   auto observable = [&](size_t i) { return i >= unobservable.size() || !unobservable[i]; };
   const size_t offsets = estimate.time_offset_s.size();
