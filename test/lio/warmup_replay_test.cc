@@ -28,6 +28,34 @@ OdometryConfig Calibrating(double warmup_replay_s) {
   return config;
 }
 
+// The calibrating config with the replay in two passes, the last one held.
+OdometryConfig TwoPassesLastHeld(const sim::SimulatedSource& source) {
+  OdometryConfig config = Calibrating(1.0);
+  config.calibration.warmup_replay_passes = 2;
+  config.calibration.warmup_replay_hold = true;
+  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
+  return config;
+}
+
+// Feeds every frame of `source` to `odometry`, each scan's status checked: the number of scans,
+// the index of the scan that replayed the warm-up (-1: none) and its result.
+void FeedAll(sim::SimulatedSource* source, LioOdometry* odometry, int* scans, int* replayed_at,
+             ScanResult* replay) {
+  io::ScanFrame frame;
+  *scans = 0;
+  *replayed_at = -1;
+  while (source->Next(&frame)) {
+    for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
+    const ScanResult r = odometry->AddScan(lioapp::TakeLidarScan(&frame));
+    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
+    if (r.revised_scans > 0) {
+      *replayed_at = *scans;
+      *replay = r;
+    }
+    ++*scans;
+  }
+}
+
 TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   sim::SimulatedSource source(WrongStart(1.5));
   OdometryConfig config = Calibrating(1.0);
@@ -98,25 +126,13 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
 // with the calibration held at those values; the scans after the span move it again.
 TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
   sim::SimulatedSource source(WrongStart(1.6));
-  OdometryConfig config = Calibrating(1.0);
-  config.calibration.warmup_replay_passes = 2;
-  config.calibration.warmup_replay_hold = true;
-  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
-  LioOdometry odometry(config);
-  io::ScanFrame frame;
+  LioOdometry odometry(TwoPassesLastHeld(source));
   int scans = 0, replayed_at = -1;
-  while (source.Next(&frame)) {
-    for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
-    const ScanResult r = odometry.AddScan(lioapp::TakeLidarScan(&frame));
-    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
-    if (r.revised_scans > 0) {
-      replayed_at = scans;
-      EXPECT_NE(r.message.find("2 passes"), std::string::npos) << r.message;
-      EXPECT_NE(r.message.find("held over the span"), std::string::npos) << r.message;
-    }
-    ++scans;
-  }
+  ScanResult replay;
+  ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));
   ASSERT_GE(replayed_at, 9);
+  EXPECT_NE(replay.message.find("2 passes"), std::string::npos) << replay.message;
+  EXPECT_NE(replay.message.find("held over the span"), std::string::npos) << replay.message;
   ASSERT_LE(replayed_at + 4, scans);
   // The carrying-on pipeline started from the first pass's estimates: nearer the true 20 ms
   // than the live warm-up's last estimate (which its first pass started from).
@@ -154,21 +170,12 @@ TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
 // others.
 TEST(WarmupReplay, UnobservableCoordinatesStartFromTheConfigAndAreNotHeld) {
   sim::SimulatedSource source(testing::WrongCalibrationSequence(sim::Regime::kSlow, 1.6, 0.020));
-  OdometryConfig config = Calibrating(1.0);
-  config.calibration.warmup_replay_passes = 2;
-  config.calibration.warmup_replay_hold = true;
-  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
+  const OdometryConfig config = TwoPassesLastHeld(source);
   const SE3 nominal = config.T_imu_lidar;
   LioOdometry odometry(config);
-  io::ScanFrame frame;
   int scans = 0, replayed_at = -1;
-  while (source.Next(&frame)) {
-    for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
-    const ScanResult r = odometry.AddScan(lioapp::TakeLidarScan(&frame));
-    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
-    if (r.revised_scans > 0) replayed_at = scans;
-    ++scans;
-  }
+  ScanResult replay;
+  ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));
   ASSERT_GE(replayed_at, 9);
   // Which coordinates the last pass held: the same on every scan of the span.
   const std::vector<bool> held = odometry.results()[1].calibration.held;

@@ -68,6 +68,18 @@ void AddNote(ScanResult* result, const std::string& note) {
   result->message += (result->message.empty() ? "" : "; ") + note;
 }
 
+// How CalibrationStates() splits: the clock offsets, then the extrinsic when estimated.
+struct CalibrationShape {
+  int offsets = 0;
+  bool extrinsic = false;
+};
+CalibrationShape ShapeOf(const std::vector<StateId>& states) {
+  CalibrationShape shape;
+  shape.extrinsic = !states.empty() && states.back() == kExtrinsicKey;
+  shape.offsets = static_cast<int>(states.size()) - (shape.extrinsic ? 1 : 0);
+  return shape;
+}
+
 std::vector<Vec3> Positions(const std::vector<TimedPoint>& points) {
   std::vector<Vec3> out;
   out.reserve(points.size());
@@ -395,10 +407,9 @@ bool LioOdometry::StartObservability() {
   if (config_.calibration.observability_horizon_scans == 0) return false;
   const std::vector<StateId> states = CalibrationStates();
   if (states.empty()) return false;
-  const bool extrinsic = states.back() == kExtrinsicKey;
-  const int offsets = static_cast<int>(states.size()) - (extrinsic ? 1 : 0);
-  observability_ =
-      std::make_unique<CalibrationObservability>(config_.calibration, offsets, extrinsic);
+  const CalibrationShape shape = ShapeOf(states);
+  observability_ = std::make_unique<CalibrationObservability>(config_.calibration, shape.offsets,
+                                                              shape.extrinsic);
   return true;
 }
 
@@ -409,12 +420,9 @@ void LioOdometry::HoldCalibration(double t_end, ScanResult* result) {
   Eigen::VectorXd sigma;
   if (t_end <= hold_calibration_until_s_ + 1e-6) {
     // The last pass of a warm-up replay over its span (calibration.warmup_replay_hold).
-    const std::vector<StateId> states = CalibrationStates();
-    const bool extrinsic = !states.empty() && states.back() == kExtrinsicKey;
-    const std::vector<double> prior =
-        cal.PriorSigmas(static_cast<int>(states.size()) - (extrinsic ? 1 : 0), extrinsic);
-    hold.assign(prior.size(), true);
-    for (size_t i = 0; i < hold_mask_.size() && i < hold.size(); ++i) hold[i] = hold_mask_[i];
+    const CalibrationShape shape = ShapeOf(CalibrationStates());
+    const std::vector<double> prior = cal.PriorSigmas(shape.offsets, shape.extrinsic);
+    hold = hold_mask_.empty() ? std::vector<bool>(prior.size(), true) : hold_mask_;
     sigma =
         Eigen::Map<const Eigen::VectorXd>(prior.data(), static_cast<Eigen::Index>(prior.size()));
   } else if (cal.hold_unobservable && StartObservability()) {
@@ -476,8 +484,7 @@ void LioOdometry::ReportCalibrationCovariance(ScanResult* result) {
   // The extrinsic's tangent is PoseManifold's left [ρ; φ].
   const std::vector<StateId> states = CalibrationStates();
   if (states.empty()) return;
-  const bool extrinsic = states.back() == kExtrinsicKey;
-  const int offsets = static_cast<int>(states.size()) - (extrinsic ? 1 : 0);
+  const auto [offsets, extrinsic] = ShapeOf(states);
   // Their marginal covariance is the inverse of their marginal information: every residual of
   // the window linearised once, every other state marginalised by the Schur complement
   // (degeneracy.h, as for the observability check). Its pseudo-inverse drops the null direction

@@ -131,9 +131,10 @@ class LioOdometry {
   // (calibration_observability.h), ν and the unobservable ones into result->calibration.
   void AssessCalibrationObservability(ScanResult* result);
   // Before the registration: a strong prior at the current value along every coordinate the
-  // previous scan left unobservable (calibration.hold_unobservable), or along all of them when
-  // the scan ends (t_end: seconds since the first scan began) within hold_calibration_until_s_,
-  // so that the solve does not move it; ReleaseCalibration removes them after the solve.
+  // previous scan left unobservable (calibration.hold_unobservable), or along those of
+  // hold_mask_ when the scan ends (t_end: seconds since the first scan began) within
+  // hold_calibration_until_s_, so that the solve does not move it; ReleaseCalibration removes
+  // them after the solve.
   void HoldCalibration(double t_end, ScanResult* result);
   void ReleaseCalibration();
   // The calibration states the estimator keeps in the window (the baseline has none), in the
