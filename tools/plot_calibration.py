@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Plots the odometry's online calibration over time (calibration.csv of ctlio_odometry --out):
-each estimate with its ±3σ band, the truth when calibration.yaml states one (simulator), and in
-grey the spans the observability check reported the coordinate unobservable. After a warm-up
+each estimate with its ±3σ band, the truth when calibration.yaml states one (simulator), in
+grey the spans the observability check reported the coordinate unobservable, and hatched the
+spans a hold prior kept it at its value (the held pass of a warm-up replay, hold_unobservable). After a warm-up
 replay (calibration.warmup_replay_s) calibration.csv holds the replayed estimates, which start
 from the values reached at the replay; calibration_live.csv, the estimates returned live before
 it, is drawn as a dashed line up to a vertical line at the replay.
@@ -36,19 +37,29 @@ def read_columns(path):
     return cols
 
 
-def unobservable_spans(t, status):
-    """[(t_begin, t_end)] over which the observability check reported the coordinate
-    unobservable (held during the next scan)."""
-    spans, begin = [], None
-    for i, s in enumerate(status):
-        if s == "unobservable" and begin is None:
+def spans(t, flags):
+    """[(t_begin, t_end)] over which flags[i] is true: from the first scan of a run of true flags
+    to the first scan after it (or the last scan)."""
+    out, begin = [], None
+    for i, on in enumerate(flags):
+        if on and begin is None:
             begin = t[i]
-        elif s != "unobservable" and begin is not None:
-            spans.append((begin, t[i]))
+        elif not on and begin is not None:
+            out.append((begin, t[i]))
             begin = None
     if begin is not None:
-        spans.append((begin, t[-1]))
-    return spans
+        out.append((begin, t[-1]))
+    return out
+
+
+def unobservable_spans(t, status):
+    """Where the observability check reported the coordinate unobservable."""
+    return spans(t, [s == "unobservable" for s in status])
+
+
+def held_spans(t, held):
+    """Where a hold prior kept the coordinate at its value in the scan's solve (column 1)."""
+    return spans(t, [h == 1 for h in held])
 
 
 def read_truth(folder):
@@ -98,18 +109,18 @@ def plot(folder):
         if m:
             series.append((f"IMU {m.group(1)} time offset [ms]", h,
                            f"time_offset_{m.group(1)}_sigma_s", 1e3, int(m.group(1)),
-                           f"time_offset_{m.group(1)}_status"))
+                           f"time_offset_{m.group(1)}"))
     # The extrinsic: its deviation from the starting value, [rho; phi] of T = Exp([rho; phi]) T_start.
     for a in "xyz":
         key = f"extrinsic_rho_{a}_m"
         if key in cols:
             series.append((f"extrinsic rho_{a} [cm]", key, f"extrinsic_rho_{a}_sigma_m", 1e2, key,
-                           f"extrinsic_rho_{a}_status"))
+                           f"extrinsic_rho_{a}"))
     for a in "xyz":
         key = f"extrinsic_phi_{a}_deg"
         if key in cols:
             series.append((f"extrinsic phi_{a} [deg]", key, f"extrinsic_phi_{a}_sigma_deg", 1.0,
-                           key, f"extrinsic_phi_{a}_status"))
+                           key, f"extrinsic_phi_{a}"))
     if not series:
         return
     live_path = os.path.join(folder, "calibration_live.csv")
@@ -118,7 +129,7 @@ def plot(folder):
     truth = read_truth(folder)
     truth.update(read_extrinsic_truth(folder))
     fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
-    for ax, (label, key, sigma_key, scale, imu, status_key) in zip(axes[:, 0], series):
+    for ax, (label, key, sigma_key, scale, imu, coordinate) in zip(axes[:, 0], series):
         est = [scale * v for v in cols[key]]
         sig = [scale * v for v in cols.get(sigma_key, [math.nan] * len(est))]
         ax.plot(t, est, color="tab:red", label="estimate")
@@ -130,8 +141,12 @@ def plot(folder):
                     label="live, before the replay")
             ax.axvline(t_live[-1], color="tab:blue", lw=0.8, label="warm-up replay")
         # Grey: unobservable from the measurements of the horizon (held in the next scan).
-        for n, (b, e) in enumerate(unobservable_spans(t, cols.get(status_key, []))):
+        for n, (b, e) in enumerate(unobservable_spans(t, cols.get(coordinate + "_status", []))):
             ax.axvspan(b, e, color="0.6", alpha=0.3, lw=0, label="unobservable" if n == 0 else None)
+        # Hatched: held at its value by a hold prior (not estimated in those scans' solves).
+        for n, (b, e) in enumerate(held_spans(t, cols.get(coordinate + "_held", []))):
+            ax.axvspan(b, e, facecolor="none", edgecolor="tab:green", hatch="//", lw=0,
+                       label="held" if n == 0 else None)
         if imu in truth:
             ax.axhline(scale * truth[imu], color="k", linestyle="--", label="truth")
         ax.set_ylabel(label)

@@ -111,8 +111,21 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
   if (observability) {
     for (const std::string& c : coordinates) f << ',' << c << "_information," << c << "_status";
   }
+  // Which coordinates a hold prior kept at their value in the scan's solve (the held pass of a
+  // warm-up replay, hold_unobservable): without these the plot cannot tell a held estimate from
+  // a converged one.
+  // The same columns in calibration.csv and calibration_live.csv (the live scans were not held).
+  const auto holds = [](const std::vector<lio::ScanResult>& results) {
+    return std::any_of(results.begin(), results.end(),
+                       [](const lio::ScanResult& r) { return !r.calibration.held.empty(); });
+  };
+  const std::vector<lio::ScanResult>& rows = scans != nullptr ? *scans : run.scans;
+  const bool held = holds(run.scans) || holds(rows);
+  if (held) {
+    for (const std::string& c : coordinates) f << ',' << c << "_held";
+  }
   f << "\n" << std::setprecision(10);
-  for (const lio::ScanResult& r : scans != nullptr ? *scans : run.scans) {
+  for (const lio::ScanResult& r : rows) {
     const auto& c = r.calibration;
     if (c.time_offset_s.size() != imus || (imus == 0 && !extrinsic)) continue;
     if (extrinsic && !c.has_extrinsic) continue;
@@ -134,6 +147,11 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
       for (size_t i = 0; i < coordinates.size(); ++i) {
         f << ',';
         WriteCoordinateObservability(c, i, f);
+      }
+    }
+    if (held) {
+      for (size_t i = 0; i < coordinates.size(); ++i) {
+        f << ',' << (i < c.held.size() && c.held[i] ? 1 : 0);
       }
     }
     f << "\n";

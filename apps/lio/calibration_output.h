@@ -38,7 +38,8 @@ std::vector<double> UnobservableFraction(const RunSummary& run);
 // CSV, one row per scan with an estimate: t_s, then per IMU j time_offset_j_s,
 // time_offset_j_sigma_s (NaN σ: not computed), then the extrinsic's columns when estimated, then
 // with the observability check per coordinate <name>_information (ν) and <name>_status
-// (observable | unobservable).
+// (observable | unobservable), then, when any scan held a coordinate (warm-up replay's held pass,
+// hold_unobservable), per coordinate <name>_held (1: held at its value in that scan's solve).
 // The write is checked (an error names the path). `scans`: run.scans by default; after a warm-up
 // replay also run.warmup_live_scans (the estimates returned live before it), same columns.
 void WriteCalibrationLog(const std::string& path, const RunSummary& run,
