@@ -2,10 +2,10 @@
 """Plots the odometry's online calibration over time (calibration.csv of ctlio_odometry --out):
 each estimate with its ±3σ band, the truth when calibration.yaml states one (simulator), in
 grey the spans the observability check reported the coordinate unobservable, and hatched the
-spans a hold prior kept it at its value (the held pass of a warm-up replay, hold_unobservable). After a warm-up
-replay (calibration.warmup_replay_s) calibration.csv holds the replayed estimates, which start
-from the values reached at the replay; calibration_live.csv, the estimates returned live before
-it, is drawn as a dashed line up to a vertical line at the replay.
+spans a hold prior kept it at its value (the held pass of a warm-up replay, hold_unobservable).
+After a warm-up replay (calibration.warmup_replay_s) calibration.csv holds the replayed
+estimates, which start from the values reached at the replay; calibration_live.csv, the
+estimates returned live before it, is drawn as a dashed line up to a vertical line at the replay.
 
 Usage: plot_calibration.py FOLDER [FOLDER ...]   (writes FOLDER/calibration.png)
 """

@@ -113,14 +113,14 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
   }
   // Which coordinates a hold prior kept at their value in the scan's solve (the held pass of a
   // warm-up replay, hold_unobservable): without these the plot cannot tell a held estimate from
-  // a converged one.
-  // The same columns in calibration.csv and calibration_live.csv (the live scans were not held).
+  // a converged one. Decided over run.scans as well, so that calibration_live.csv (whose scans a
+  // held pass never holds) gets the same columns as calibration.csv.
   const auto holds = [](const std::vector<lio::ScanResult>& results) {
     return std::any_of(results.begin(), results.end(),
                        [](const lio::ScanResult& r) { return !r.calibration.held.empty(); });
   };
   const std::vector<lio::ScanResult>& rows = scans != nullptr ? *scans : run.scans;
-  const bool held = holds(run.scans) || holds(rows);
+  const bool held = holds(run.scans) || (scans != nullptr && holds(*scans));
   if (held) {
     for (const std::string& c : coordinates) f << ',' << c << "_held";
   }
