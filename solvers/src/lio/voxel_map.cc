@@ -25,7 +25,9 @@ VoxelMap::VoxelMap(const Options& options)
     : options_(options),
       inverse_voxel_size_(1.0 / options.voxel_size),
       min_distance2_(options.min_point_distance * options.min_point_distance),
-      stride_(static_cast<size_t>(std::max(options.max_points_per_voxel, 1))) {
+      stride_(static_cast<size_t>(std::max(options.max_points_per_voxel, 1))),
+      record_lines_((kHeaderBytes + stride_ * sizeof(Vec3) + sizeof(CacheLine) - 1) /
+                    sizeof(CacheLine)) {
   if (!(options.voxel_size > 0.0) || options.max_points_per_voxel < 1 ||
       !(options.min_point_distance >= 0.0) || !(options.max_distance > 0.0)) {
     throw std::invalid_argument(
@@ -39,34 +41,43 @@ int32_t VoxelMap::Find(const VoxelKey& key) const {
   const uint64_t mask = slots_.size() - 1;
   for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
     const int32_t voxel = slots_[s];
-    if (voxel == kNoVoxel || keys_[voxel] == key) return voxel;
+    if (voxel == kNoVoxel || HeaderOf(voxel)->key == key) return voxel;
   }
 }
 
+void VoxelMap::ConstructRecord(int32_t voxel, const VoxelKey& key) {
+  if (static_cast<size_t>(voxel) >> kChunkBits >= pool_.size()) {
+    pool_.emplace_back(new CacheLine[(size_t{1} << kChunkBits) * record_lines_]);
+  }
+  unsigned char* bytes = RecordOf(voxel)->bytes;
+  new (bytes) VoxelHeader{key, 0};
+  // Eigen's default constructor leaves the coordinates unset: this only begins the points'
+  // lifetimes, it writes nothing.
+  std::uninitialized_default_construct_n(reinterpret_cast<Vec3*>(bytes + kHeaderBytes), stride_);
+}
+
 int32_t VoxelMap::FindOrAdd(const VoxelKey& key) {
-  if (2 * (keys_.size() + 1) > slots_.size()) Rehash(2 * (keys_.size() + 1));
+  if (2 * (num_voxels_ + 1) > slots_.size()) Rehash(2 * (num_voxels_ + 1));
   const uint64_t mask = slots_.size() - 1;
   for (uint64_t s = HashOf(key) & mask;; s = (s + 1) & mask) {
     int32_t& slot = slots_[s];
     if (slot != kNoVoxel) {
-      if (keys_[slot] == key) return slot;
+      if (HeaderOf(slot)->key == key) return slot;
       continue;
     }
-    if (keys_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+    if (num_voxels_ >= static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
       throw std::length_error("VoxelMap: more than 2^31 voxels");
     }
-    slot = static_cast<int32_t>(keys_.size());
-    keys_.push_back(key);
-    counts_.push_back(0);
+    const int32_t voxel = static_cast<int32_t>(num_voxels_);
+    ConstructRecord(voxel, key);
+    ++num_voxels_;
+    slot = voxel;
     if (options_.fit_planes) {
       moments_.emplace_back();
       planes_.emplace_back();
       changed_.push_back(0);
     }
-    if ((keys_.size() - 1) >> kChunkBits >= pool_.size()) {
-      pool_.emplace_back(new Vec3[(size_t{1} << kChunkBits) * stride_]);
-    }
-    return slot;
+    return voxel;
   }
 }
 
@@ -75,8 +86,8 @@ void VoxelMap::Rehash(size_t min_slots) {
   while (n < min_slots) n *= 2;
   slots_.assign(n, kNoVoxel);
   const uint64_t mask = n - 1;
-  for (size_t i = 0; i < keys_.size(); ++i) {
-    uint64_t s = HashOf(keys_[i]) & mask;
+  for (size_t i = 0; i < num_voxels_; ++i) {
+    uint64_t s = HashOf(HeaderOf(static_cast<int32_t>(i))->key) & mask;
     while (slots_[s] != kNoVoxel) s = (s + 1) & mask;
     slots_[s] = static_cast<int32_t>(i);
   }
@@ -118,14 +129,15 @@ inline bool VoxelMap::HasPointCloserThanMin(const Vec3* points, int32_t n, const
 }
 
 inline bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
-  int32_t& count = counts_[voxel];
+  VoxelHeader& header = *HeaderOf(voxel);
+  int32_t& count = header.count;
   if (count >= options_.max_points_per_voxel) return false;
   Vec3* points = BlockOf(voxel);
   if (HasPointCloserThanMin(points, count, p)) return false;
   points[count++] = p;
   ++num_points_;
   if (options_.fit_planes) {
-    const VoxelKey& k = keys_[voxel];
+    const VoxelKey& k = header.key;
     const Vec3 d = p - Vec3(k.x, k.y, k.z) * options_.voxel_size;
     Moments& m = moments_[voxel];
     m.sum += d;
@@ -146,7 +158,7 @@ inline bool VoxelMap::InsertInto(int32_t voxel, const Vec3& p) {
 void VoxelMap::RefitChangedPlanes() {
   for (const int32_t voxel : changed_voxels_) {
     changed_[voxel] = 0;
-    const int32_t n = counts_[voxel];
+    const int32_t n = HeaderOf(voxel)->count;
     VoxelPlane& plane = planes_[voxel];
     plane.points = 0;
     if (n < 3) continue;
@@ -158,7 +170,7 @@ void VoxelMap::RefitChangedPlanes() {
     Mat3 cov;
     cov << m.sq[0], m.sq[1], m.sq[2], m.sq[1], m.sq[3], m.sq[4], m.sq[2], m.sq[4], m.sq[5];
     cov = cov * inv_n - mean_d * mean_d.transpose();
-    const VoxelKey& k = keys_[voxel];
+    const VoxelKey& k = HeaderOf(voxel)->key;
     if (FitPlaneFromMoments(Vec3(k.x, k.y, k.z) * options_.voxel_size + mean_d, cov, &plane.fit)) {
       plane.points = n;
     }
@@ -199,17 +211,17 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
   // Compacts the surviving voxels to the front (in order) and rebuilds the table.
   const double max2 = options_.max_distance * options_.max_distance;
   size_t kept = 0;
-  for (size_t i = 0; i < keys_.size(); ++i) {
-    const VoxelKey& k = keys_[i];
+  for (size_t i = 0; i < num_voxels_; ++i) {
+    const VoxelHeader& header = *HeaderOf(static_cast<int32_t>(i));
+    const VoxelKey& k = header.key;
     const Vec3 centre = (Vec3(k.x, k.y, k.z) + Vec3::Constant(0.5)) * options_.voxel_size;
     if ((centre - location).squaredNorm() > max2) {
-      num_points_ -= static_cast<size_t>(counts_[i]);
+      num_points_ -= static_cast<size_t>(header.count);
       continue;
     }
     if (kept != i) {
-      keys_[kept] = keys_[i];
-      counts_[kept] = counts_[i];
-      std::copy_n(BlockOf(static_cast<int32_t>(i)), counts_[i],
+      *HeaderOf(static_cast<int32_t>(kept)) = header;
+      std::copy_n(BlockOf(static_cast<int32_t>(i)), header.count,
                   BlockOf(static_cast<int32_t>(kept)));
       if (options_.fit_planes) {  // no refit pending: every Insert ends with one
         moments_[kept] = moments_[i];
@@ -218,10 +230,9 @@ size_t VoxelMap::RemoveFar(const Vec3& location) {
     }
     ++kept;
   }
-  const size_t removed = keys_.size() - kept;
+  const size_t removed = num_voxels_ - kept;
   if (removed == 0) return 0;
-  keys_.resize(kept);
-  counts_.resize(kept);
+  num_voxels_ = kept;
   if (options_.fit_planes) {
     moments_.resize(kept);
     planes_.resize(kept);
@@ -278,8 +289,7 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
 
 void VoxelMap::Clear() {
   slots_.clear();
-  keys_.clear();
-  counts_.clear();
+  num_voxels_ = 0;
   pool_.clear();
   moments_.clear();
   planes_.clear();

@@ -6,11 +6,12 @@
 // it (±1 voxel): every map point within one voxel size of the query is found exactly.
 //
 // Storage is flat: an open-addressing table (linear probing, load ≤ 1/2) maps a voxel key to a
-// voxel index, and the points of voxel i occupy a fixed block of max_points_per_voxel slots in
-// a pool of chunks (256 voxels each: the pool grows without reallocating, so without copies and
-// without a transient second pool in the peak memory). A lookup is a hash and a few adjacent
-// slots, and a voxel's points are one contiguous block, instead of a node chain and a separate
-// heap block per voxel.
+// voxel index, and voxel i is one record in a pool of chunks (256 voxels each: the pool grows
+// without reallocating, so without copies and without a transient second pool in the peak
+// memory): its key and point count, then a fixed block of max_points_per_voxel points, the record
+// aligned to a cache line. A lookup is a hash, a few adjacent slots and the record, whose first
+// line holds the key to compare, the count and the first points: two cache misses for a voxel
+// not in cache, where separate key, count and point arrays were four.
 //
 // Per-voxel planes (Options::fit_planes, as in iG-LIO and VoxelMap): each voxel also keeps the
 // sums Σd and Σd·dᵀ of its points (d relative to the voxel's corner, so the sums stay well
@@ -24,6 +25,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "ctlio/manifolds/types.h"
@@ -115,26 +117,48 @@ class VoxelMap {
   const VoxelPlane* PlaneOf(const Vec3& p) const;
 
   size_t num_points() const { return num_points_; }
-  size_t num_voxels() const { return keys_.size(); }
+  size_t num_voxels() const { return num_voxels_; }
   const Options& options() const { return options_; }
   void Clear();
 
   // Calls f(key, VoxelPoints) for every voxel (unordered).
   template <typename F>
   void ForEachVoxel(F&& f) const {
-    for (size_t i = 0; i < keys_.size(); ++i) f(keys_[i], PointsOf(static_cast<int32_t>(i)));
+    for (size_t i = 0; i < num_voxels_; ++i) {
+      const int32_t voxel = static_cast<int32_t>(i);
+      f(HeaderOf(voxel)->key, PointsOf(voxel));
+    }
   }
 
  private:
   static constexpr int32_t kNoVoxel = -1;
   static constexpr int kChunkBits = 8;  // 256 voxels per pool chunk
-  Vec3* BlockOf(int32_t voxel) const {
+  // A voxel's record: this header, then max_points_per_voxel points (kHeaderBytes on).
+  struct VoxelHeader {
+    VoxelKey key;
+    int32_t count = 0;
+  };
+  static constexpr size_t kHeaderBytes = 16;
+  static_assert(sizeof(VoxelHeader) <= kHeaderBytes && kHeaderBytes % alignof(Vec3) == 0);
+  struct alignas(64) CacheLine {
+    unsigned char bytes[64];
+  };
+  CacheLine* RecordOf(int32_t voxel) const {
     constexpr int32_t kChunkMask = (1 << kChunkBits) - 1;
-    return pool_[voxel >> kChunkBits].get() + static_cast<size_t>(voxel & kChunkMask) * stride_;
+    return pool_[voxel >> kChunkBits].get() +
+           static_cast<size_t>(voxel & kChunkMask) * record_lines_;
+  }
+  VoxelHeader* HeaderOf(int32_t voxel) const {
+    return std::launder(reinterpret_cast<VoxelHeader*>(RecordOf(voxel)->bytes));
+  }
+  Vec3* BlockOf(int32_t voxel) const {
+    return std::launder(reinterpret_cast<Vec3*>(RecordOf(voxel)->bytes + kHeaderBytes));
   }
   VoxelPoints PointsOf(int32_t voxel) const {
-    return {BlockOf(voxel), static_cast<size_t>(counts_[voxel])};
+    return {BlockOf(voxel), static_cast<size_t>(HeaderOf(voxel)->count)};
   }
+  // Starts voxel's record (key, no points) in the pool; voxel is the next index.
+  void ConstructRecord(int32_t voxel, const VoxelKey& key);
   // The voxel index of key, or kNoVoxel.
   int32_t Find(const VoxelKey& key) const;
   // The voxel index of key, creating an empty voxel if there is none.
@@ -175,14 +199,14 @@ class VoxelMap {
   Options options_;
   double inverse_voxel_size_;
   double min_distance2_;
-  size_t stride_;  // max_points_per_voxel
+  size_t stride_;        // max_points_per_voxel
+  size_t record_lines_;  // cache lines per record: header + stride_ points
   // Voxel index per slot (kNoVoxel: empty), power-of-two size or empty; the key is compared in
-  // keys_. 4 bytes a slot rather than the key's 12 more: the table of a mapped room (~1 MB with
-  // the keys) stays in L2, where a lookup was an L3 miss.
+  // the record. 4 bytes a slot rather than the key's 12 more: the table of a mapped room stays
+  // in L2, where a lookup was an L3 miss.
   std::vector<int32_t> slots_;
-  std::vector<VoxelKey> keys_;                 // per voxel
-  std::vector<int32_t> counts_;                // per voxel
-  std::vector<std::unique_ptr<Vec3[]>> pool_;  // chunks of 2^kChunkBits · stride_ points
+  size_t num_voxels_ = 0;
+  std::vector<std::unique_ptr<CacheLine[]>> pool_;  // chunks of 2^kChunkBits records
   // With fit_planes only, per voxel:
   std::vector<Moments> moments_;
   std::vector<VoxelPlane> planes_;
