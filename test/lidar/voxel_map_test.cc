@@ -206,6 +206,19 @@ TEST(VoxelMap, KNearestWithinOneVoxelEqualsBruteForce) {
   EXPECT_GT(nonempty, 500);
 }
 
+// Before the first insertion there is no slot table at all; after removing every voxel there is
+// one with every slot empty (the search's first probe answers "no voxel" for each neighbour).
+TEST(VoxelMap, KNearestOnAnEmptyMapFindsNothing) {
+  VoxelMap map(DefaultOptions());
+  std::vector<VoxelMap::Neighbour> out(3);
+  EXPECT_EQ(map.KNearest(Vec3(0.5, 0.5, 0.5), 5, &out), 0);
+  EXPECT_TRUE(out.empty());
+  map.Insert(Vec3(0.5, 0.5, 0.5));
+  EXPECT_EQ(map.KNearest(Vec3(0.6, 0.5, 0.5), 5, &out), 1);
+  EXPECT_EQ(map.RemoveFar(Vec3(1000.0, 0.0, 0.0)), 1u);
+  EXPECT_EQ(map.KNearest(Vec3(0.6, 0.5, 0.5), 5, &out), 0);
+}
+
 // Without a radius: the k nearest among all points of the 27 voxels around the query.
 TEST(VoxelMap, KNearestSearchesPlusMinusOneVoxel) {
   std::mt19937 rng(14);

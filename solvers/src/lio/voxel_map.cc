@@ -192,7 +192,26 @@ size_t VoxelMap::Insert(const std::vector<Vec3>& points) {
   int32_t last_voxel = kNoVoxel;
   VoxelKey last_key;
   recent_.assign(size_t{1} << kRecentBits, RecentVoxel{});
-  for (const Vec3& p : points) {
+  // Prefetching a few points ahead, as KNearest does for its neighbours: the slot of point
+  // i + 2·kAhead, then (its slot cached by then) the record of point i + kAhead, so that a voxel's
+  // record is in cache when its point is inserted. Hints only: the lookups below are unchanged.
+  constexpr size_t kAhead = 8;
+  const auto slot_of = [&](size_t j) -> const int32_t* {
+    const Vec3& a = points[j];
+    if (slots_.empty() || !a.allFinite()) return nullptr;
+    return &slots_[HashOf(VoxelKeyOf(a, inverse_voxel_size_)) & (slots_.size() - 1)];
+  };
+  for (size_t i = 0; i < points.size(); ++i) {
+#if defined(__GNUC__)
+    if (i + 2 * kAhead < points.size()) {
+      if (const int32_t* slot = slot_of(i + 2 * kAhead)) __builtin_prefetch(slot);
+    }
+    if (i + kAhead < points.size()) {
+      const int32_t* slot = slot_of(i + kAhead);
+      if (slot != nullptr && *slot != kNoVoxel) __builtin_prefetch(RecordOf(*slot));
+    }
+#endif
+    const Vec3& p = points[i];
     if (!p.allFinite()) continue;
     const VoxelKey key = VoxelKeyOf(p, inverse_voxel_size_);
     if (last_voxel == kNoVoxel || !(key == last_key)) {
@@ -264,9 +283,29 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
     order[i] = {box2 * options_.voxel_size * options_.voxel_size, i};
   }
   std::sort(order.begin(), order.end());
-  for (const auto& [box2, i] : order) {
-    if (box2 > max2) break;
+  // The first probe of each candidate's slot first, the record there prefetched: the records of
+  // the few occupied neighbours then arrive together instead of one miss after the other as the
+  // visit reaches them (the 4-byte slots are mostly cached, the records are not). An empty first
+  // slot is a definite "no voxel" (linear probing); any other is resolved by Find when visited.
+  std::array<bool, 27> absent;
+  int candidates = 0;
+  if (!slots_.empty()) {
+    const uint64_t mask = slots_.size() - 1;
+    for (; candidates < 27 && order[candidates].first <= max2; ++candidates) {
+      const int i = order[candidates].second;
+      const VoxelKey key{c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1};
+      const int32_t first = slots_[HashOf(key) & mask];
+      absent[candidates] = first == kNoVoxel;
+#if defined(__GNUC__)
+      if (first != kNoVoxel) __builtin_prefetch(RecordOf(first));
+#endif
+    }
+  }
+  for (int v = 0; v < candidates; ++v) {
+    const double box2 = order[v].first;
     if (static_cast<int>(out->size()) == k && box2 >= out->back().squared_distance) break;
+    if (absent[v]) continue;
+    const int i = order[v].second;
     const int32_t voxel = Find({c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1});
     if (voxel == kNoVoxel) continue;
     for (const Vec3& p : PointsOf(voxel)) {

@@ -150,7 +150,9 @@ struct OdometryConfig {
 
   // --- Per-method overrides (YAML key `per_method`): the complete configuration to use when
   // running that method, i.e. this one with the override's keys replaced. One file can so
-  // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side.
+  // hold values tuned for Singer-LIO and for the IMU-as-input baseline side by side. Each entry
+  // is resolved when the file is read: a field changed in code afterwards must be changed in the
+  // entries too, or ForMethod of an overridden method runs the file's value.
   std::map<LioMethod, std::shared_ptr<const OdometryConfig>> per_method;
   // The configuration that runs `m`: its override if there is one, else this one; `method` = m.
   OdometryConfig ForMethod(LioMethod m) const;
