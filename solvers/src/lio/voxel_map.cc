@@ -287,14 +287,15 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
   // the few occupied neighbours then arrive together instead of one miss after the other as the
   // visit reaches them (the 4-byte slots are mostly cached, the records are not). An empty first
   // slot is a definite "no voxel" (linear probing); any other is resolved by Find when visited.
+  std::array<VoxelKey, 27> keys;
   std::array<bool, 27> absent;
   int candidates = 0;
   if (!slots_.empty()) {
     const uint64_t mask = slots_.size() - 1;
     for (; candidates < 27 && order[candidates].first <= max2; ++candidates) {
       const int i = order[candidates].second;
-      const VoxelKey key{c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1};
-      const int32_t first = slots_[HashOf(key) & mask];
+      keys[candidates] = {c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1};
+      const int32_t first = slots_[HashOf(keys[candidates]) & mask];
       absent[candidates] = first == kNoVoxel;
 #if defined(__GNUC__)
       if (first != kNoVoxel) __builtin_prefetch(RecordOf(first));
@@ -305,8 +306,7 @@ int VoxelMap::KNearest(const Vec3& q, int k, std::vector<Neighbour>* out,
     const double box2 = order[v].first;
     if (static_cast<int>(out->size()) == k && box2 >= out->back().squared_distance) break;
     if (absent[v]) continue;
-    const int i = order[v].second;
-    const int32_t voxel = Find({c.x + i / 9 - 1, c.y + (i / 3) % 3 - 1, c.z + i % 3 - 1});
+    const int32_t voxel = Find(keys[v]);
     if (voxel == kNoVoxel) continue;
     for (const Vec3& p : PointsOf(voxel)) {
       const double d2 = (p - q).squaredNorm();
