@@ -4,7 +4,9 @@
 // knots and extrinsics, points sharing a firing); with a Cauchy or Huber loss, Ceres sees the
 // cost, gradient and Gauss–Newton Hessian of N one-point blocks with that loss
 // (ceres::Problem::Evaluate of both problems); a convex loss fails the evaluation instead of
-// returning a wrong cost.
+// returning a wrong cost. The square-root form (W + 1 rows) gives Ceres the same cost, gradient and
+// Gauss–Newton Hessian as the point rows, with and without a loss and the extrinsic, over several
+// row chunks, for a rank-deficient batch (one firing) too, and the same values for any row runner.
 #include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
 
 #include <ceres/crs_matrix.h>
@@ -166,12 +168,17 @@ Evaluated EvaluateProblem(const std::vector<ceres::CostFunction*>& costs, ceres:
   return out;
 }
 
-void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
+using Form = ContinuousPointToPlaneBatch::Form;
+
+// The batch (of `form`, `n` points) against n one-point blocks with the loss: cost, gradient and
+// JᵀJ within `tolerance` of their largest entries (the cost of itself).
+void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed, Form form = Form::kPointRows,
+                           int n = 12, double tolerance = 1e-12) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 6; ++trial) {
     const int kind = trial % 3;
     const bool extrinsic = trial >= 3;
-    const auto points = RandomPoints(rng, 12);
+    const auto points = RandomPoints(rng, n);
     const Knots at = extrinsic ? KnotsOfKind(rng, kind) : WithoutExtrinsic(KnotsOfKind(rng, kind));
     std::vector<std::unique_ptr<ceres::CostFunction>> owned;
     std::vector<ceres::CostFunction*> singles;
@@ -187,20 +194,24 @@ void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed) {
     // The batch shares the loss without owning it (the problem above does not own it either).
     ContinuousPointToPlaneBatch batch(
         points, std::shared_ptr<const ceres::LossFunction>(loss, [](const ceres::LossFunction*) {}),
-        extrinsic);
-    ASSERT_EQ(batch.num_residuals(), 13);  // one row per point and the constant row
+        extrinsic, form);
+    // Point rows: one per point and the constant row (with a loss); square root: W + 1.
+    const int rows =
+        form == Form::kSquareRoot ? (extrinsic ? 43 : 37) : n + (loss != nullptr ? 1 : 0);
+    ASSERT_EQ(batch.num_residuals(), rows);
     const Evaluated a = EvaluateProblem(singles, loss, at);
     const Evaluated b = EvaluateProblem({&batch}, nullptr, at);
-    EXPECT_NEAR(b.cost, a.cost, 1e-12 * a.cost) << "trial " << trial;
+    EXPECT_NEAR(b.cost, a.cost, tolerance * a.cost) << "trial " << trial;
     ASSERT_EQ(a.gradient.size(), b.gradient.size());
     const double g_scale = Eigen::Map<const Eigen::VectorXd>(
                                a.gradient.data(), static_cast<Eigen::Index>(a.gradient.size()))
                                .cwiseAbs()
                                .maxCoeff();
     for (size_t i = 0; i < a.gradient.size(); ++i) {
-      EXPECT_NEAR(b.gradient[i], a.gradient[i], 1e-12 * g_scale) << "trial " << trial << " " << i;
+      EXPECT_NEAR(b.gradient[i], a.gradient[i], tolerance * g_scale)
+          << "trial " << trial << " " << i;
     }
-    EXPECT_LE((b.JtJ - a.JtJ).cwiseAbs().maxCoeff(), 1e-12 * a.JtJ.cwiseAbs().maxCoeff())
+    EXPECT_LE((b.JtJ - a.JtJ).cwiseAbs().maxCoeff(), tolerance * a.JtJ.cwiseAbs().maxCoeff())
         << "trial " << trial;
   }
 }
@@ -217,6 +228,82 @@ TEST(ContinuousPointToPlaneBatch, HuberGivesCeresPerPointCostGradientAndHessian)
   ExpectSameLinearModel(&loss, 54);
 }
 
+// The square-root form: 12 points (one chunk, fewer points than rows: allowed, if pointless) and
+// 150 (three chunks of 64, 64 and 22 rows). Measured differences: <= 3e-13 of the largest entry
+// (the LDLᵀ and its triangular solves add rounding the point rows do not have).
+TEST(ContinuousPointToPlaneBatch, SquareRootGivesThePointRowsCostGradientAndHessian) {
+  ceres::CauchyLoss cauchy(2.0);
+  ceres::HuberLoss huber(2.0);
+  for (const int n : {12, 150}) {
+    SCOPED_TRACE("points " + std::to_string(n));
+    ExpectSameLinearModel(nullptr, 60, Form::kSquareRoot, n, 1e-10);
+    ExpectSameLinearModel(&cauchy, 61, Form::kSquareRoot, n, 1e-10);
+    ExpectSameLinearModel(&huber, 62, Form::kSquareRoot, n, 1e-10);
+  }
+}
+
+// Without Jacobians (a cost-only evaluation: Ceres' trial points) the square-root form returns
+// zeros and the whole cost in its last row: ½‖r‖² is the point rows' cost. With Jacobians the
+// rows differ, their squares summing to the same cost.
+TEST(ContinuousPointToPlaneBatch, SquareRootCostOnlyEvaluationCarriesTheCost) {
+  std::mt19937 rng(63);
+  const auto loss = std::make_shared<const ceres::CauchyLoss>(2.0);
+  const auto points = RandomPoints(rng, 100);
+  const ContinuousPointToPlaneBatch rows(points, loss);
+  const ContinuousPointToPlaneBatch root(points, loss, false, Form::kSquareRoot);
+  const Knots s = WithoutExtrinsic(KnotsOfKind(rng, 1));
+  std::vector<double> r(rows.num_residuals()), q(root.num_residuals(), -1.0);
+  ASSERT_TRUE(rows.Evaluate(s.Params().data(), r.data(), nullptr));
+  ASSERT_TRUE(root.Evaluate(s.Params().data(), q.data(), nullptr));
+  const double cost = 0.5 * Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()).squaredNorm();
+  for (int i = 0; i + 1 < root.num_residuals(); ++i) EXPECT_EQ(q[i], 0.0) << i;
+  EXPECT_NEAR(0.5 * q.back() * q.back(), cost, 1e-13 * cost);
+  std::vector<std::vector<double>> J(6);
+  std::vector<double*> pj(6);
+  for (int b = 0; b < 6; ++b) {
+    J[b].assign(root.num_residuals() * root.parameter_block_sizes()[b], 0.0);
+    pj[b] = J[b].data();
+  }
+  ASSERT_TRUE(root.Evaluate(s.Params().data(), q.data(), pj.data()));
+  EXPECT_GT(Eigen::Map<const Eigen::VectorXd>(q.data(), 36).norm(), 0.0);
+  EXPECT_NEAR(0.5 * Eigen::Map<const Eigen::VectorXd>(q.data(), q.size()).squaredNorm(), cost,
+              1e-12 * cost);
+}
+
+// Every point on one firing: the rows' Jacobians span at most the 6 directions of δT(τ), so JᵀJ
+// has rank <= 6 of 36. The square-root form keeps that information and drops the rest (zero rows),
+// with the cost, gradient and JᵀJ of the point rows and nothing non-finite.
+TEST(ContinuousPointToPlaneBatch, SquareRootOfARankDeficientBatch) {
+  std::mt19937 rng(64);
+  const auto model = ctlio::testing::NewerCollegeSingerModel();
+  const auto firing = std::make_shared<const SharedPoseInterpolation>(
+      std::make_shared<const gp::GpInterpolator>(model, 0.0, 0.1, 0.04));
+  std::vector<ContinuousPointToPlaneBatch::Point> points;
+  std::vector<std::unique_ptr<ceres::CostFunction>> owned;
+  std::vector<ceres::CostFunction*> singles;
+  for (int i = 0; i < 50; ++i) {
+    points.push_back({firing, RandomAssociation(rng), Vec3::Zero()});
+    owned.push_back(std::make_unique<ContinuousPointToPlane>(firing, points.back().association));
+    singles.push_back(owned.back().get());
+  }
+  ContinuousPointToPlaneBatch root(points, nullptr, false, Form::kSquareRoot);
+  const Knots at = WithoutExtrinsic(KnotsOfKind(rng, 0));
+  const Evaluated a = EvaluateProblem(singles, nullptr, at);
+  const Evaluated b = EvaluateProblem({&root}, nullptr, at);
+  ASSERT_TRUE(b.JtJ.allFinite());
+  EXPECT_NEAR(b.cost, a.cost, 1e-10 * a.cost);
+  const double g_scale =
+      Eigen::Map<const Eigen::VectorXd>(a.gradient.data(), 36).cwiseAbs().maxCoeff();
+  for (size_t i = 0; i < a.gradient.size(); ++i) {
+    EXPECT_NEAR(b.gradient[i], a.gradient[i], 1e-10 * g_scale) << i;
+  }
+  EXPECT_LE((b.JtJ - a.JtJ).cwiseAbs().maxCoeff(), 1e-10 * a.JtJ.cwiseAbs().maxCoeff());
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a.JtJ);
+  int rank = 0;
+  for (Eigen::Index i = 0; i < 36; ++i) rank += eig.eigenvalues()[i] > 1e-9 * eig.eigenvalues()[35];
+  EXPECT_EQ(rank, 6);
+}
+
 TEST(ContinuousPointToPlaneBatch, ConvexLossFailsTheEvaluation) {
   std::mt19937 rng(55);
   const ContinuousPointToPlaneBatch batch(RandomPoints(rng, 3),
@@ -224,24 +311,31 @@ TEST(ContinuousPointToPlaneBatch, ConvexLossFailsTheEvaluation) {
   const Knots s = WithoutExtrinsic(KnotsOfKind(rng, 0));
   std::vector<double> r(4);
   EXPECT_FALSE(batch.Evaluate(s.Params().data(), r.data(), nullptr));
+  const ContinuousPointToPlaneBatch root(RandomPoints(rng, 3),
+                                         std::make_shared<const ceres::TolerantLoss>(1.0, 0.5),
+                                         false, Form::kSquareRoot);
+  std::vector<double> q(37);
+  EXPECT_FALSE(root.Evaluate(s.Params().data(), q.data(), nullptr));
 }
 
 // A row runner may split the rows anyhow and run the pieces in any order, on any thread: the
 // residuals (the constant row too) and every Jacobian are those of the batch without one, bit for
-// bit. The runner here splits 40 rows unevenly and runs the pieces last first; with the extrinsic
-// and with a Cauchy loss; a convex loss still fails the evaluation.
-TEST(ContinuousPointToPlaneBatch, RowRunnerGivesTheSameValuesBitForBit) {
-  std::mt19937 rng(56);
-  const auto points = RandomPoints(rng, 40);
-  const auto runner = [](size_t n, const std::function<void(size_t, size_t)>& rows) {
-    const std::vector<size_t> cuts = {n, 2 * n / 3, n / 2, 1, 0};
+// bit. The runner here splits its work items unevenly and runs the pieces last first: 40 rows,
+// and in square-root form 4 chunks (200 rows); with the extrinsic and with a Cauchy loss; a
+// convex loss still fails the evaluation.
+void ExpectRunnerGivesTheSameValues(Form form, int n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const auto points = RandomPoints(rng, n);
+  const auto runner = [](size_t items, const std::function<void(size_t, size_t)>& rows) {
+    const std::vector<size_t> cuts = {items, 2 * items / 3, items / 2, 1, 0};
     for (size_t j = 0; j + 1 < cuts.size(); ++j) rows(cuts[j + 1], cuts[j]);
   };
   for (const bool extrinsic : {false, true}) {
     for (const bool robust : {false, true}) {
+      SCOPED_TRACE("extrinsic " + std::to_string(extrinsic) + " robust " + std::to_string(robust));
       const auto loss = robust ? std::make_shared<const ceres::CauchyLoss>(2.0) : nullptr;
-      const ContinuousPointToPlaneBatch plain(points, loss, extrinsic);
-      ContinuousPointToPlaneBatch split(points, loss, extrinsic);
+      const ContinuousPointToPlaneBatch plain(points, loss, extrinsic, form);
+      ContinuousPointToPlaneBatch split(points, loss, extrinsic, form);
       split.set_row_runner(runner);
       const Knots k = KnotsOfKind(rng, 0);
       const Knots s = extrinsic ? k : WithoutExtrinsic(k);
@@ -258,18 +352,30 @@ TEST(ContinuousPointToPlaneBatch, RowRunnerGivesTheSameValuesBitForBit) {
       std::vector<double> ra(m, -1.0), rb(m, -2.0);
       ASSERT_TRUE(plain.Evaluate(s.Params().data(), ra.data(), pa.data()));
       ASSERT_TRUE(split.Evaluate(s.Params().data(), rb.data(), pb.data()));
-      EXPECT_EQ(ra, rb) << "extrinsic " << extrinsic << " robust " << robust;
+      EXPECT_EQ(ra, rb);
       for (size_t b = 0; b < blocks; ++b) EXPECT_EQ(Ja[b], Jb[b]) << "block " << b;
-      std::vector<double> r_only(m, -3.0);
+      std::vector<double> r_only(m, -3.0), r_plain(m, -4.0);
       ASSERT_TRUE(split.Evaluate(s.Params().data(), r_only.data(), nullptr));
-      EXPECT_EQ(ra, r_only);
+      ASSERT_TRUE(plain.Evaluate(s.Params().data(), r_plain.data(), nullptr));
+      EXPECT_EQ(r_plain, r_only);
+      // The point rows are the same with or without Jacobians (the square-root rows are not).
+      if (form == Form::kPointRows) EXPECT_EQ(ra, r_only);
     }
   }
-  ContinuousPointToPlaneBatch convex(points, std::make_shared<const ceres::TolerantLoss>(1.0, 0.5));
+  ContinuousPointToPlaneBatch convex(points, std::make_shared<const ceres::TolerantLoss>(1.0, 0.5),
+                                     false, form);
   convex.set_row_runner(runner);
-  std::vector<double> r(41);
+  std::vector<double> r(convex.num_residuals());
   EXPECT_FALSE(
       convex.Evaluate(WithoutExtrinsic(KnotsOfKind(rng, 0)).Params().data(), r.data(), nullptr));
+}
+
+TEST(ContinuousPointToPlaneBatch, RowRunnerGivesTheSameValuesBitForBit) {
+  ExpectRunnerGivesTheSameValues(Form::kPointRows, 40, 56);
+}
+
+TEST(ContinuousPointToPlaneBatch, RowRunnerGivesTheSameSquareRootValuesBitForBit) {
+  ExpectRunnerGivesTheSameValues(Form::kSquareRoot, 200, 57);
 }
 
 TEST(ContinuousPointToPlaneBatch, NoPointsIsAnError) {

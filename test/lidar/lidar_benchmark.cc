@@ -4,6 +4,7 @@
 // Report medians: --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -250,7 +251,8 @@ BENCHMARK(BM_ContinuousPointToPlaneInSolve)->Arg(1)->Arg(20);
 
 // The real-data test's pipeline on sweep 00 (25,109 points): preprocessing, keypoints, rigid
 // fit, then the two-knot continuous-time registration, with a residual block per keypoint
-// (first arg 0, residual_blocks "point") or one for the interval (1, the default); second arg: the
+// (first arg 0, residual_blocks "point"), one for the interval (1, "interval") or that block in
+// square-root form (2, "square_root", the default); second arg: the
 // threads of the front end and of the window's solve (lidar_frontend.threads = window.threads).
 void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
   if (!std::filesystem::is_directory(kFolder)) {
@@ -268,7 +270,8 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
     t_end = std::max(t_end, sweep[i].time);
   }
   LidarFrontendOptions options;
-  options.residual_blocks = state.range(0) == 0 ? "point" : "interval";
+  options.residual_blocks =
+      std::array<const char*, 3>{"point", "interval", "square_root"}[state.range(0)];
   options.threads = static_cast<int>(state.range(1));
   const gp::SingerModel<6> model = testing::NewerCollegeSingerModel();
   LidarFrontend map_frontend(options);
@@ -292,7 +295,9 @@ void BM_RegisterNewerCollegeSweep(benchmark::State& state) {
 BENCHMARK(BM_RegisterNewerCollegeSweep)
     ->Args({0, 1})
     ->Args({1, 1})
+    ->Args({2, 1})
     ->Args({1, 2})
+    ->Args({2, 2})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

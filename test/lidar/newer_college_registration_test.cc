@@ -42,9 +42,9 @@ struct SweepResult {
   size_t points = 0, keypoints = 0;
   double before = 0, rigid = 0, after = 0;
   RegistrationSummary summary;
-  // The shipped default registers with one residual block for the interval (residual_blocks
-  // "interval"); the same registration with a block per keypoint ("point") ends this far from it
-  // (largest knot translation difference, m, and rotation difference, rad).
+  // The shipped default registers with one residual block for the interval in square-root form
+  // (residual_blocks "square_root"); the same registration with a block per keypoint ("point") ends
+  // this far from it (largest knot translation difference, m, and rotation difference, rad).
   double point_blocks_translation = 0, point_blocks_rotation = 0;
 };
 

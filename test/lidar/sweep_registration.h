@@ -86,7 +86,7 @@ inline RegistrationSummary RegisterContinuous(const VoxelMap& map,
   }
   window.AddResidualBlock(new gp::SingerPrior(model, t_k1 - t_k), nullptr, KnotPair(a, b));
   ContinuousLidarTerm term(model, t_k, t_k1, a, b, keypoints, &window);
-  term.set_batched(options.residual_blocks == "interval");  // as the odometry builds it
+  term.set_residual_blocks(options.residual_blocks);  // as the odometry builds it
   const RegistrationSummary summary =
       ScanRegistration(options, OdometryConfig().min_associations).Register(map, &term, &window);
   *k = gp::ReadKnotState(window.State(a.pose), window.State(a.velocity),

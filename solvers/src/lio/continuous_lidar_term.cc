@@ -117,13 +117,19 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
   }
   for (size_t j = 0; j < points.size(); ++j) {
     if (points[j].empty()) continue;
-    auto* batch = new ContinuousPointToPlaneBatch(std::move(points[j]), loss);
-    if (const int threads = window->options().threads; threads > 1) {
-      // In the window's solve only (SlidingWindow::solving), and a few hundred rows are worth a
-      // second thread (~0.1 ms each per evaluation); a handful not.
+    using Form = ContinuousPointToPlaneBatch::Form;
+    // The square-root form has W + 1 = 37 rows: fewer only for more points than that.
+    const Form form = batch_form_ == Form::kSquareRoot && points[j].size() > 37 ? Form::kSquareRoot
+                                                                                : Form::kPointRows;
+    // A few hundred rows are worth a second thread (~0.1 ms each per evaluation); a handful not.
+    const bool worth_threads = points[j].size() >= 128;
+    auto* batch = new ContinuousPointToPlaneBatch(std::move(points[j]), loss,
+                                                  /*with_extrinsic=*/false, form);
+    if (const int threads = window->options().threads; threads > 1 && worth_threads) {
+      // In the window's solve only (SlidingWindow::solving).
       batch->set_row_runner(
           [threads, window](size_t n, const std::function<void(size_t, size_t)>& rows) {
-            ParallelFor(window->solving() && n >= 128 ? threads : 1, n,
+            ParallelFor(window->solving() ? threads : 1, n,
                         [&](size_t, size_t begin, size_t end) { rows(begin, end); });
           });
     }

@@ -328,7 +328,7 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
                   ? std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints,
                                                           scan.T_robot_lidar, window)
                   : std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
-  term->set_batched(config_.frontend.residual_blocks == "interval");
+  term->set_residual_blocks(config_.frontend.residual_blocks);
   return term;
 }
 

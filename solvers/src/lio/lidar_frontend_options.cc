@@ -39,8 +39,9 @@ void LidarFrontendOptions::Validate() const {
   require(solver_iterations <= 1000, "solver_iterations must be <= 1000 per round");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
-  require(residual_blocks == "point" || residual_blocks == "interval",
-          "residual_blocks must be point or interval");
+  require(residual_blocks == "point" || residual_blocks == "interval" ||
+              residual_blocks == "square_root",
+          "residual_blocks must be point, interval or square_root");
   require(point_noise_sigma > 0.0, "point_noise_sigma must be positive");
   require(loss_scale > 0.0, "loss_scale must be positive");
   require(convergence_translation >= 0.0 && convergence_rotation >= 0.0,

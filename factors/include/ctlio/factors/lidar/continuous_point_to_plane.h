@@ -62,19 +62,28 @@ class ContinuousPointToPlane final : public ceres::SizedCostFunction<1, 7, 6, 6,
     const bool want_k1 =
         jacobians != nullptr &&
         (jacobians[3] != nullptr || jacobians[4] != nullptr || jacobians[5] != nullptr);
+    Eigen::Matrix<double, 1, 18> J_k, J_k1;
+    const double e = EvaluateTangent(pose, m, parameters, want_k ? &J_k : nullptr,
+                                     want_k1 ? &J_k1 : nullptr, J_tau);
+    if (want_k) WriteKnotJacobians(J_k, parameters[0], jacobians);
+    if (want_k1) WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
+    return e;
+  }
+
+  // The same residual with its Jacobians in the knots' tangent spaces, [δT, δϖ, δϖ̇] of knot k
+  // and of knot k+1 (1×18 each, nullable), before EvaluateAtKnots lifts them into the ambient
+  // blocks; and de/dδT(τ) (nullable).
+  static double EvaluateTangent(const SharedPoseInterpolation& pose, const PlaneAssociation& m,
+                                double const* const* parameters, Eigen::Matrix<double, 1, 18>* J_k,
+                                Eigen::Matrix<double, 1, 18>* J_k1,
+                                Eigen::Matrix<double, 1, 6>* J_tau) {
+    const bool chain = J_k != nullptr || J_k1 != nullptr;
     SharedPoseInterpolation::Scratch scratch;
-    const SharedPoseInterpolation::Result& x = pose.Pose(parameters, want_k || want_k1, &scratch);
-    if (!want_k && !want_k1 && J_tau == nullptr) {
-      return lidar::PointToPlaneError(x.at.T, m, nullptr);
-    }
+    const SharedPoseInterpolation::Result& x = pose.Pose(parameters, chain, &scratch);
+    if (!chain && J_tau == nullptr) return lidar::PointToPlaneError(x.at.T, m, nullptr);
     Eigen::Matrix<double, 1, 6> J;
     const double e = lidar::PointToPlaneError(x.at.T, m, &J);
-    if (want_k || want_k1) {
-      Eigen::Matrix<double, 1, 18> J_k, J_k1;
-      pose.Chain(x, J, want_k ? &J_k : nullptr, want_k1 ? &J_k1 : nullptr);
-      if (want_k) WriteKnotJacobians(J_k, parameters[0], jacobians);
-      if (want_k1) WriteKnotJacobians(J_k1, parameters[3], jacobians + 3);
-    }
+    if (chain) pose.Chain(x, J, J_k, J_k1);
     if (J_tau != nullptr) *J_tau = J;
     return e;
   }

@@ -30,6 +30,29 @@
 // With the extrinsic (online calibration) each row is instead the ContinuousPointToPlaneExtrinsic
 // residual of the point's lidar-frame coordinates, T_rl read once per evaluation.
 //
+// Square-root form (Form::kSquareRoot). Those rows reach Ceres only through JᵀJ, Jᵀr and ‖r‖²:
+// the Levenberg–Marquardt step, its model cost change and acceptance test, the Jacobi scaling and
+// the marginalisation's linearisation are functions of these three alone. N rows on the W = 36
+// tangent coordinates of the interval's knots (42 with T_rl) can therefore reach Ceres as W + 1
+// equivalent rows (the square-root information form of the batch):
+//
+//   R (W×W) with RᵀR = JᵀJ,   r₀ with Rᵀr₀ = Jᵀr,   and the constant row √(‖r‖² − ‖r₀‖²),
+//
+// so cost, gradient and Gauss–Newton Hessian are those of the N rows up to rounding. What it saves
+// is Ceres' serial per-row work, which grows with N: zeroing, filling and checking its dense
+// Jacobian and the JᵀJ of its normal equations (a Singer-LIO scan's solve, N ≈ 600: 0.81× the
+// instructions, README "LIO latency"). JᵀJ is formed here instead, per chunk of kChunkRows rows on
+// the row runner (the chunks' sums added in chunk order: the same values for any split). R is the
+// Cholesky factor with complete pivoting of the Jacobi-scaled JᵀJ (unit diagonal), rank-revealing:
+// it stops where the largest remaining Schur-complement pivot is at most kPivotThreshold, and the
+// rows left zero carry no information above rounding: ~W³/3 flops, 5–9 µs per evaluation at
+// W = 36, where an eigendecomposition (InformationSquareRoot's, for the marginal prior) takes
+// ~95 µs; Eigen's LDLT pivots on the original diagonal and is not rank-revealing.
+// Evaluated without Jacobians the block returns r₀ = 0 and the whole cost in the last row: such an
+// evaluation serves the cost, and the W + 1 values mean something only together with their
+// Jacobians, which are not the derivative of the residuals — numeric differentiation does not
+// apply; the tests compare cost, gradient and JᵀJ with the point rows'.
+//
 // Parameter blocks: pose_k (7, PoseManifold), ϖ_k (6), ϖ̇_k (6), pose_k+1, ϖ_k+1, ϖ̇_k+1 — those of
 // every point's interpolation (each SharedPoseInterpolation must interpolate on this interval) —
 // and, with the extrinsic, T_rl (7, PoseManifold).
@@ -54,6 +77,12 @@ namespace ctlio {
 
 class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
  public:
+  // kPointRows: one row per point (and the constant row with a loss). kSquareRoot: W + 1 rows
+  // carrying the same cost, gradient and Gauss–Newton Hessian (above).
+  enum class Form { kPointRows, kSquareRoot };
+  static constexpr size_t kChunkRows = 64;          // rows per chunk of the square-root form
+  static constexpr double kPivotThreshold = 1e-12;  // of the Jacobi-scaled JᵀJ (unit diagonal)
+
   struct Point {
     std::shared_ptr<const SharedPoseInterpolation> pose;  // at the point's τ, on this interval
     PlaneAssociation association;     // with the extrinsic its point_robot is not read
@@ -64,15 +93,21 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
   // `with_extrinsic`: a seventh block T_rl, each point entering as T_rl·point_lidar.
   ContinuousPointToPlaneBatch(std::vector<Point> points,
                               std::shared_ptr<const ceres::LossFunction> loss,
-                              bool with_extrinsic = false)
-      : points_(std::move(points)), loss_(std::move(loss)), blocks_(with_extrinsic ? 7 : 6) {
+                              bool with_extrinsic = false, Form form = Form::kPointRows)
+      : points_(std::move(points)),
+        loss_(std::move(loss)),
+        blocks_(with_extrinsic ? 7 : 6),
+        form_(form) {
     if (points_.empty()) throw std::invalid_argument("ContinuousPointToPlaneBatch: no points");
-    set_num_residuals(static_cast<int>(points_.size()) + (loss_ != nullptr ? 1 : 0));
+    set_num_residuals(form_ == Form::kSquareRoot
+                          ? tangent_size() + 1
+                          : static_cast<int>(points_.size()) + (loss_ != nullptr ? 1 : 0));
     for (int b = 0; b < blocks_; ++b) mutable_parameter_block_sizes()->push_back(kBlockSizes[b]);
   }
 
   // Runs rows(begin, end) over a split of [0, n) into contiguous ranges, possibly concurrently,
-  // and returns when all have run (e.g. ctlio::ParallelFor's chunks).
+  // and returns when all have run (e.g. ctlio::ParallelFor's chunks). n counts the rows of the
+  // point-row form and the chunks of kChunkRows rows of the square-root form (work_items()).
   using RowRunner =
       std::function<void(size_t n, const std::function<void(size_t begin, size_t end)>& rows)>;
 
@@ -83,6 +118,7 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    if (form_ == Form::kSquareRoot) return EvaluateSquareRoot(parameters, residuals, jacobians);
     const size_t n = points_.size();
     const bool extrinsic = blocks_ == 7;
     const SE3 T_rl = extrinsic ? PoseManifold::Pose(parameters[6]) : SE3();
@@ -155,13 +191,26 @@ class ContinuousPointToPlaneBatch final : public ceres::CostFunction {
   size_t size() const { return points_.size(); }
   const Point& point(size_t i) const { return points_[i]; }
   const ceres::LossFunction* loss() const { return loss_.get(); }
+  Form form() const { return form_; }
+  // W: the tangent coordinates of the blocks, 36 (42 with T_rl).
+  int tangent_size() const { return 6 * blocks_; }
+  // The n a row runner is called with.
+  size_t work_items() const {
+    return form_ == Form::kSquareRoot ? (points_.size() + kChunkRows - 1) / kChunkRows
+                                      : points_.size();
+  }
 
  private:
   static constexpr int kBlockSizes[7] = {7, 6, 6, 7, 6, 6, 7};
 
+  // The square-root form (continuous_point_to_plane_batch.cc).
+  bool EvaluateSquareRoot(double const* const* parameters, double* residuals,
+                          double** jacobians) const;
+
   std::vector<Point> points_;
   std::shared_ptr<const ceres::LossFunction> loss_;
   int blocks_;
+  Form form_;
   RowRunner row_runner_;
 };
 

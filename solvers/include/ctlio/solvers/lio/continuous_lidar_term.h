@@ -12,9 +12,11 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/lidar/continuous_point_to_plane_batch.h"
 #include "ctlio/factors/lidar/shared_pose_interpolation.h"
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/scan_registration.h"
@@ -59,15 +61,20 @@ class ContinuousLidarTerm final : public LidarTerm {
   void UpdateResidual(size_t i, const PlaneAssociation& association) override;
   SE3 NewestPose() const override;  // T_rm of the last knot
 
-  // With `batched` (LidarFrontendOptions::residual_blocks "interval") the keypoints of each knot
-  // interval form one ContinuousPointToPlaneBatch block instead of one block each. Not with the
-  // extrinsic estimated: batched() is then false and the residuals stay per keypoint, so the
-  // calibration results stay those measured. (The batch's extrinsic form matches the per-point
-  // factors' cost, gradient and Hessian; in a calibrating window the first marginal prior is
-  // nearly singular along pose–extrinsic directions just above the rank threshold, and its
+  // As LidarFrontendOptions::residual_blocks: "point", one block per keypoint; "interval" and
+  // "square_root" batch the keypoints of each knot interval into one ContinuousPointToPlaneBatch
+  // of point rows or in square-root form (that only where it has fewer rows: more than W + 1 = 37
+  // points). Not with the extrinsic estimated: batched() is then false and the residuals stay per
+  // keypoint, so the calibration results stay those measured. (The batch's extrinsic form matches
+  // the per-point factors' cost, gradient and Hessian; in a calibrating window the first marginal
+  // prior is nearly singular along pose–extrinsic directions just above the rank threshold, and its
   // residual r0 there amplifies rounding — Sᵀr0 equal to 1e-11, ‖r0‖ 1.109 vs 1.160 — so on
   // sparse 1 s runs the two diverge by millimetres, on a 3 s full-firing run by 1e-7 m.)
-  void set_batched(bool batched) { batched_ = batched; }
+  void set_residual_blocks(const std::string& residual_blocks) {
+    batched_ = residual_blocks == "interval" || residual_blocks == "square_root";
+    batch_form_ = residual_blocks == "square_root" ? ContinuousPointToPlaneBatch::Form::kSquareRoot
+                                                   : ContinuousPointToPlaneBatch::Form::kPointRows;
+  }
   bool batched() const override { return batched_ && extrinsic_ == nullptr; }
   void SetBatchResiduals(const std::vector<uint8_t>& associated,
                          const std::vector<PlaneAssociation>& planes,
@@ -101,6 +108,7 @@ class ContinuousLidarTerm final : public LidarTerm {
   const double* extrinsic_ = nullptr;
   SE3 T_rl_;
   bool batched_ = false;
+  ContinuousPointToPlaneBatch::Form batch_form_ = ContinuousPointToPlaneBatch::Form::kPointRows;
 };
 
 }  // namespace ctlio::lio
