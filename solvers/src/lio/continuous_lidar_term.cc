@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <stdexcept>
+#include <vector>
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
@@ -33,21 +34,31 @@ ContinuousLidarTerm::ContinuousLidarTerm(const gp::SingerModel<6>& model,
   const double t_first = knots.front().t, t_last = knots.back().t;
   firing_.resize(keypoints.size());
   std::map<double, int> by_time;
+  std::vector<double> taus;  // per firing
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const double tau = std::clamp(keypoints[i].time, t_first, t_last);
-    const auto [it, inserted] = by_time.try_emplace(tau, static_cast<int>(firings_.size()));
+    const auto [it, inserted] = by_time.try_emplace(tau, static_cast<int>(taus.size()));
     if (inserted) {
       // The interval that holds τ: the first whose end is not before it.
       size_t j = 0;
       while (j + 2 < knots.size() && tau > knots[j + 1].t) ++j;
       interval_.push_back(static_cast<int>(j));
-      firings_.push_back(std::make_shared<SharedPoseInterpolation>(
-          std::make_shared<const gp::GpInterpolator>(model, knots[j].t, knots[j + 1].t, tau),
-          blocks_[j]));
-      window->shared_interpolations().Add(firings_.back());
+      taus.push_back(tau);
     }
     firing_[i] = it->second;
   }
+  // The firings' interpolators (~5k instructions each, ~600 per scan) on the window's threads;
+  // registered with the window in firing order.
+  firings_.resize(taus.size());
+  ParallelFor(window->options().threads, taus.size(), [&](size_t, size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      const size_t j = static_cast<size_t>(interval_[f]);
+      firings_[f] = std::make_shared<SharedPoseInterpolation>(
+          std::make_shared<const gp::GpInterpolator>(model, knots[j].t, knots[j + 1].t, taus[f]),
+          blocks_[j]);
+    }
+  });
+  for (const auto& firing : firings_) window->shared_interpolations().Add(firing);
 }
 
 void ContinuousLidarTerm::BeginRound() {
