@@ -174,7 +174,7 @@ void WriteBarSvg(const std::string& path,
         f << "<rect x='" << x0 + m * bar << "' y='" << y << "' width='" << bar * 0.9 << "' height='"
           << bottom - y << "' fill='" << colours[m % 6] << "'/><text x='"
           << x0 + m * bar + bar * 0.45 << "' y='" << y - 3 << "' text-anchor='middle' "
-          << "font-size='10'>" << std::round(1000 * v) / 10 << "</text>\n";
+          << "font-size='10'>" << lioapp::CentimetreLabel(v) << "</text>\n";
       }
     }
   }

@@ -200,4 +200,10 @@ void WritePooledCsv(const std::string& path, const std::vector<PooledCell>& cell
   io::CloseChecked(f, path);
 }
 
+std::string CentimetreLabel(double metres) {
+  std::ostringstream s;
+  s << std::setprecision(2) << 100.0 * metres;
+  return s.str();
+}
+
 }  // namespace ctlio::lioapp

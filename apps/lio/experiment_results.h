@@ -56,4 +56,9 @@ std::vector<PooledCell> PoolRows(const std::vector<RunRow>& rows);
 std::string PooledTableMarkdown(const std::vector<PooledCell>& cells);
 void WritePooledCsv(const std::string& path, const std::vector<PooledCell>& cells);
 
+// A table2.svg bar label: `metres` in centimetres with two significant digits (0.26, 0.73, 1.3),
+// so that close values of the small regimes stay apart (one decimal showed 0.26 and 0.34 cm both
+// as 0.3).
+std::string CentimetreLabel(double metres);
+
 }  // namespace ctlio::lioapp

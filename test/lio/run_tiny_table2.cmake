@@ -24,3 +24,21 @@ list(LENGTH lines n)
 if(NOT n EQUAL 7)  # header + 3 regimes × 2 methods
   message(FATAL_ERROR "results.csv has ${n} lines, expected 7")
 endif()
+# The bars' labels (RMSE ATE in cm) carry two significant digits: one decimal showed 0.26 and
+# 0.34 cm both as "0.3".
+file(READ ${OUT}/table2.svg svg)
+string(REGEX MATCHALL "font-size='10'>[^<]*<" labels "${svg}")
+list(LENGTH labels n)
+if(NOT n EQUAL 6)  # 3 regimes × 2 methods
+  message(FATAL_ERROR "table2.svg has ${n} bar labels, expected 6:\n${svg}")
+endif()
+foreach(label ${labels})
+  string(REGEX REPLACE "font-size='10'>([^<]*)<" "\\1" value "${label}")
+  string(REGEX REPLACE "e.*$" "" mantissa "${value}")
+  string(REGEX REPLACE "[.]" "" digits "${mantissa}")
+  string(REGEX REPLACE "^0+" "" digits "${digits}")
+  string(LENGTH "${digits}" length)
+  if(length LESS 1 OR length GREATER 2)
+    message(FATAL_ERROR "table2.svg bar label '${value}' is not two significant digits")
+  endif()
+endforeach()
