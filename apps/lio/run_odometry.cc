@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <fstream>
 #include <iomanip>
 #include <optional>
@@ -335,7 +336,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     if (r.revised_scans > 0) {
       // The calibration warm-up replay replaced the earlier scans' results: tally those instead
       // (their dense samples are gone with the pipeline that made them: the scan poses stand in).
-      const std::vector<lio::ScanResult>& all = odometry->results();
+      const std::deque<lio::ScanResult>& all = odometry->results();
       ResetTally(&run);
       for (size_t i = 0; i + 1 < all.size(); ++i) {
         Tally(all[i], i, T_imu_lidar, &run);
@@ -344,7 +345,8 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
         }
       }
       run.warmup_replayed_scans = r.revised_scans;
-      run.warmup_live_scans = odometry->warmup_results();
+      run.warmup_live_scans.assign(odometry->warmup_results().begin(),
+                                   odometry->warmup_results().end());
     }
     Tally(r, done - 1, T_imu_lidar, &run);
     if (r.status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {

@@ -4,9 +4,11 @@
 // degenerate scan (reported, estimate survives).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -169,6 +171,30 @@ TEST(LioPipeline, OverlappedStagesGiveTheSameEstimates) {
         EXPECT_EQ(a.scans[i].associations, c.scans[i].associations);
         EXPECT_EQ(a.scans[i].status, b.scans[i].status);
       }
+    }
+  }
+}
+
+// OdometryConfig::kept_results: the odometry keeps the newest results only (its memory must not
+// grow with the run), and they are the ones AddScan returned; 0 keeps every one.
+TEST(LioPipeline, ResultHistoryIsBounded) {
+  for (const size_t kept : {size_t{3}, size_t{0}}) {
+    OdometryConfig config = Config(LioMethod::kSingerLio);
+    config.kept_results = kept;
+    LioOdometry odometry(config);
+    sim::SimulatedSource source(ShortSequence());
+    io::ScanFrame frame;
+    std::vector<int64_t> returned;
+    while (source.Next(&frame)) {
+      for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
+      returned.push_back(odometry.AddScan(lioapp::TakeLidarScan(&frame)).t_ns);
+      const size_t expected = kept == 0 ? returned.size() : std::min(kept, returned.size());
+      ASSERT_EQ(odometry.results().size(), expected) << "after scan " << returned.size();
+    }
+    ASSERT_EQ(returned.size(), 10u);
+    const size_t n = odometry.results().size();
+    for (size_t i = 0; i < n; ++i) {
+      EXPECT_EQ(odometry.results()[i].t_ns, returned[returned.size() - n + i]) << kept << " " << i;
     }
   }
 }

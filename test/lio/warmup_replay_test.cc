@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -84,7 +85,7 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   }
   ASSERT_EQ(replays, 1);
   ASSERT_EQ(odometry.results().size(), static_cast<size_t>(scans));
-  const std::vector<ScanResult>& live = odometry.warmup_results();
+  const std::deque<ScanResult>& live = odometry.warmup_results();
   ASSERT_GE(live.size(), 10u);
   const ScanResult::CalibrationEstimate& warm = live.back().calibration;
   ASSERT_EQ(warm.time_offset_s.size(), 1u);
@@ -121,6 +122,35 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   EXPECT_TRUE(odometry.initialised());
 }
 
+// A bounded result history (OdometryConfig::kept_results) still keeps the whole warm-up span
+// until the replay, which hands every replayed result of it to the caller; then the bound holds.
+TEST(WarmupReplay, BoundedHistoryKeepsTheSpanUntilTheReplay) {
+  sim::SimulatedSource source(WrongStart(1.5));
+  OdometryConfig config = Calibrating(1.0);
+  config.T_imu_lidar = source.ImuFromLidar();
+  config.kept_results = 3;
+  LioOdometry odometry(config);
+  io::ScanFrame frame;
+  size_t scans = 0;
+  bool replayed = false;
+  while (source.Next(&frame)) {
+    for (const io::ImuSample& x : frame.imu) odometry.AddImu(x);
+    const ScanResult r = odometry.AddScan(lioapp::TakeLidarScan(&frame));
+    ++scans;
+    ASSERT_NE(r.status, ScanStatus::kFailed) << r.message;
+    if (r.revised_scans > 0) {
+      replayed = true;
+      EXPECT_EQ(odometry.results().size(), scans);  // the span, replayed, and this scan
+      EXPECT_EQ(odometry.warmup_results().size(), scans);
+      EXPECT_EQ(odometry.results().back().t_ns, r.t_ns);
+    } else {
+      EXPECT_EQ(odometry.results().size(), replayed ? 3u : scans) << "scan " << scans;
+    }
+  }
+  EXPECT_TRUE(replayed);
+  EXPECT_GE(scans, 14u);
+}
+
 // Two passes, the last one held (calibration.warmup_replay_passes / warmup_replay_hold): the
 // second pass starts from where the first ended, not from the live estimates, and solves the span
 // with the calibration held at those values; the scans after the span move it again.
@@ -141,7 +171,7 @@ TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
   EXPECT_NE(start, live);
   EXPECT_LT(std::abs(start - 0.020), std::abs(live - 0.020));
   const SE3& T_start = odometry.config().T_imu_lidar;
-  const std::vector<ScanResult>& results = odometry.results();
+  const std::deque<ScanResult>& results = odometry.results();
   ASSERT_EQ(results.size(), static_cast<size_t>(scans));
   for (int i = 1; i <= replayed_at; ++i) {
     const ScanResult::CalibrationEstimate& c = results[static_cast<size_t>(i)].calibration;

@@ -166,6 +166,10 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   for (int pass = 0; pass < passes; ++pass) {
     const bool last = pass == passes - 1;
     OdometryConfig replay_config = ReplayConfig(start_values);
+    // The caller re-reads every replayed result of the span (ScanResult::revised_scans).
+    if (replay_config.kept_results > 0) {
+      replay_config.kept_results = std::max(replay_config.kept_results, warmup_scans_.size());
+    }
     const bool hold = last && config_.calibration.warmup_replay_hold;
     if (hold) replay_config.calibration.hold_gravity = true;
     replay = std::make_unique<LioOdometry>(replay_config);
@@ -196,6 +200,8 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   if (config_.calibration.warmup_replay_hold) note << ", the calibration held over the span";
   AddNote(&replayed, note.str());
   replay->results_.back() = replayed;
+  // The caller has re-read the span's results with this one: the configured bound holds again.
+  replay->config_.kept_results = config_.kept_results;
   warmup_results_ = std::move(results_);
   results_ = {};
   warmup_scans_ = {};
@@ -285,6 +291,10 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
   result.milliseconds = MsSince(start);
   result.cpu_ms = ThreadCpuMs() - cpu_start;
   results_.push_back(result);
+  // A pending warm-up replay replaces every result of its span: those stay until it has run.
+  if (config_.kept_results > 0 && !KeepsWarmup()) {
+    while (results_.size() > config_.kept_results) results_.pop_front();
+  }
   return result;
 }
 

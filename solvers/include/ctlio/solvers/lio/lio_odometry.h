@@ -15,6 +15,7 @@
 // The input gates (input_checks.h, thresholds in config.input) apply to every caller.
 #pragma once
 
+#include <deque>
 #include <future>
 #include <memory>
 #include <string>
@@ -52,10 +53,13 @@ class LioOdometry {
   // After a warm-up replay (calibration.warmup_replay_s) everything below is the replayed
   // pipeline's, which carries on: its config starts the calibration from the warm-up's estimates.
   const OdometryConfig& config() const { return active().config_; }
-  const std::vector<ScanResult>& results() const { return active().results_; }
+  // The newest config().kept_results results (all with 0), oldest first: a pipeline that runs
+  // for hours keeps a bounded history. While a warm-up replay is pending, every result of its
+  // span stays, and after it the replayed span's results are all here (the replay revised them).
+  const std::deque<ScanResult>& results() const { return active().results_; }
   // The results returned live for the scans of the warm-up span, before the replay replaced
   // them in results() (empty until a replay).
-  const std::vector<ScanResult>& warmup_results() const { return warmup_results_; }
+  const std::deque<ScanResult>& warmup_results() const { return warmup_results_; }
   size_t duplicate_imu_samples() const { return active().imu_.duplicates(); }
   size_t rejected_imu_samples() const { return active().imu_.rejected(); }
   bool initialised() const { return active().initialised_; }
@@ -171,7 +175,7 @@ class LioOdometry {
   bool have_last_pose_ = false;
   bool have_origin_ = false;
   bool initialised_ = false;
-  std::vector<ScanResult> results_;
+  std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
   // Online calibration's observability (created at the first assessment) over the states of
   // CalibrationStates(), and the hold priors of this scan.
@@ -192,7 +196,7 @@ class LioOdometry {
   std::vector<ImuSample> warmup_imu_;
   std::vector<std::pair<LidarScan, size_t>> warmup_scans_;
   std::unique_ptr<LioOdometry> replay_;
-  std::vector<ScanResult> warmup_results_;
+  std::deque<ScanResult> warmup_results_;
   bool warmup_done_ = false;
   // Set on the last pass of a held warm-up replay (calibration.warmup_replay_hold): the span,
   // and which coordinates to hold (those observable when the pass started; empty: all).
