@@ -51,7 +51,6 @@
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
-#include "ctlio/solvers/lio/yaml_io.h"
 #include "lio/calibration_output.h"
 #include "lio/run_odometry.h"
 
@@ -285,7 +284,7 @@ int main(int argc, char** argv) {
     // An `extrinsic:` written in the config wins over the dataset's (precedence in README).
     bool config_extrinsic = false;
     if (!FLAGS_config.empty()) {
-      const YAML::Node root = lio::LoadYamlFile(FLAGS_config, "odometry config");
+      const YAML::Node root = lio::LoadOdometryYaml(FLAGS_config);
       config_extrinsic = root["extrinsic"].IsDefined();
       base = lio::OdometryConfigFromYaml(root, FLAGS_config);
     }

@@ -2,8 +2,10 @@
 #include "ctlio/solvers/lio/odometry_config.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <string>
 
 namespace ctlio::lio {
 namespace {
@@ -180,6 +182,92 @@ TEST(OdometryConfig, CalibrationSection) {
                                             "  - {xyz_rpy: [0, 0, 0, 0, 0, 0]}\n"
                                             "calibration:\n  time_offset_s: [0.01]\n")),
                std::runtime_error);
+}
+
+// data/sim_lio_calibration.yaml extends data/sim_lio.yaml (`base:`): its own keys, and the base's
+// everywhere else, the per-method overrides included.
+TEST(OdometryConfig, CalibrationConfigExtendsTheSimConfig) {
+  const OdometryConfig sim =
+      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const OdometryConfig cal =
+      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml");
+  EXPECT_EQ(cal.knots_per_scan, 2);
+  EXPECT_DOUBLE_EQ(cal.accel_variance, 0.16);
+  EXPECT_DOUBLE_EQ(cal.accel_loss_scale, 0.5);
+  EXPECT_DOUBLE_EQ(cal.frontend.voxel_size, 0.5);
+  EXPECT_DOUBLE_EQ(cal.frontend.initial_voxel_size, 0.5);
+  EXPECT_EQ(cal.frontend.max_keypoints, 2400);
+  EXPECT_TRUE(cal.calibration.estimate_time_offset);
+  EXPECT_TRUE(cal.calibration.estimate_extrinsic);
+  EXPECT_DOUBLE_EQ(cal.calibration.warmup_replay_s, 4.0);
+  EXPECT_EQ(cal.calibration.warmup_replay_passes, 2);
+  EXPECT_TRUE(cal.calibration.warmup_replay_hold);
+  // Untouched: the base's values (which differ from the struct's defaults).
+  EXPECT_EQ(cal.qc, sim.qc);
+  EXPECT_EQ(cal.alpha, sim.alpha);
+  EXPECT_DOUBLE_EQ(cal.gyro_variance, sim.gyro_variance);
+  EXPECT_EQ(cal.frontend.max_iterations, sim.frontend.max_iterations);
+  EXPECT_DOUBLE_EQ(cal.frontend.point_noise_sigma, sim.frontend.point_noise_sigma);
+  EXPECT_NE(sim.frontend.max_keypoints, LidarFrontendOptions().max_keypoints);
+  EXPECT_EQ(cal.per_method.size(), sim.per_method.size());
+  ASSERT_FALSE(sim.per_method.empty());
+  for (const auto& [method, override_config] : sim.per_method) {
+    ASSERT_EQ(cal.per_method.count(method), 1u);
+    EXPECT_EQ(cal.per_method.at(method)->frontend.max_iterations,
+              override_config->frontend.max_iterations);
+  }
+}
+
+// `base:` overlays mapping by mapping: a key inside a section replaces that key only, a list
+// replaces the whole list; the path is relative to the extending file; bases chain.
+TEST(OdometryConfig, BaseOverlaysKeyByKey) {
+  WriteTemp("overlay_root.yaml",
+            "gp:\n  qc: [1, 2, 3, 4, 5, 6]\nwindow:\n  knots: 3\n  threads: 2\n"
+            "lidar_frontend:\n  max_keypoints: 500\n");
+  WriteTemp("overlay_mid.yaml", "base: overlay_root.yaml\nwindow:\n  knots: 4\n");
+  const OdometryConfig c = LoadOdometryConfig(
+      WriteTemp("overlay_top.yaml", "base: overlay_mid.yaml\ngp:\n  qc: [7, 7, 7, 8, 8, 8]\n"));
+  EXPECT_EQ(c.window_knots, 4);
+  EXPECT_EQ(c.solver_threads, 2);
+  EXPECT_EQ(c.frontend.max_keypoints, 500);
+  EXPECT_DOUBLE_EQ(c.qc[0], 7);
+  EXPECT_DOUBLE_EQ(c.qc[5], 8);
+  const YAML::Node merged = LoadOdometryYaml(::testing::TempDir() + "/overlay_top.yaml");
+  EXPECT_FALSE(merged["base"].IsDefined());
+  EXPECT_EQ(merged["window"]["knots"].as<int>(), 4);
+}
+
+// Errors of an extending config name the file and line of the `base:` that led there, and
+// errors inside the base name the base's own file and line.
+TEST(OdometryConfig, BaseErrorsNameTheFiles) {
+  const auto message = [](const std::string& path) {
+    try {
+      LoadOdometryConfig(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string missing =
+      WriteTemp("base_missing.yaml", "window:\n  knots: 3\nbase: no_such_config.yaml\n");
+  std::string m = message(missing);
+  EXPECT_NE(m.find(missing + ":3: base:"), std::string::npos) << m;
+  EXPECT_NE(m.find("no_such_config.yaml: cannot open"), std::string::npos) << m;
+  WriteTemp("base_bad.yaml", "window:\n  knots: 3\n  knotz: 2\n");
+  m = message(WriteTemp("base_bad_top.yaml", "base: base_bad.yaml\n"));
+  EXPECT_NE(m.find("/base_bad.yaml:3: unknown key"), std::string::npos) << m;
+  EXPECT_NE(m.find("window.knotz"), std::string::npos) << m;
+  WriteTemp("base_cycle_a.yaml", "base: base_cycle_b.yaml\n");
+  m = message(WriteTemp("base_cycle_b.yaml", "base: base_cycle_a.yaml\n"));
+  EXPECT_NE(m.find("extend each other"), std::string::npos) << m;
+  m = message(WriteTemp("base_list.yaml", "base: [a.yaml, b.yaml]\n"));
+  EXPECT_NE(m.find("must be the path"), std::string::npos) << m;
+  // A key of the extending file still names the extending file.
+  const std::string top_bad =
+      WriteTemp("base_top_bad.yaml", "base: overlay_root.yaml\nwindow:\n  overlap: 2x\n");
+  WriteTemp("overlay_root.yaml", "window:\n  knots: 3\n");
+  m = message(top_bad);
+  EXPECT_NE(m.find(top_bad + ":3"), std::string::npos) << m;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -369,8 +370,58 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
   return c;
 }
 
+namespace {
+
+// `over`'s keys onto the mapping `base`: mappings key by key, anything else replaced. The nodes
+// are shared, not copied, so that they keep their line numbers for error messages.
+void OverlayYaml(YAML::Node base, const YAML::Node& over) {
+  for (const auto& kv : over) {
+    const std::string key = kv.first.Scalar();
+    YAML::Node existing = base[key];
+    if (existing.IsMap() && kv.second.IsMap()) {
+      OverlayYaml(existing, kv.second);
+    } else {
+      base[key] = kv.second;
+    }
+  }
+}
+
+constexpr int kMaxBaseChain = 8;
+
+YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
+  YAML::Node root = LoadYamlFile(path, "odometry config");
+  const YAML::Node& read = root;
+  if (!read.IsMap() || !read["base"]) return root;
+  const YAML::Node base_key = read["base"];
+  const std::string where = YamlWhere(path, base_key.Mark()) + ": base: ";
+  if (!base_key.IsScalar() || base_key.Scalar().empty()) {
+    throw std::runtime_error(where + "must be the path of the config this one extends");
+  }
+  if (depth + 1 >= kMaxBaseChain) {
+    throw std::runtime_error(where + "more than " + std::to_string(kMaxBaseChain) +
+                             " files extend each other (a cycle?)");
+  }
+  std::filesystem::path base_path(base_key.Scalar());
+  if (base_path.is_relative()) base_path = std::filesystem::path(path).parent_path() / base_path;
+  YAML::Node merged;
+  try {
+    merged = LoadOdometryYamlChain(base_path.string(), depth + 1);
+    OdometryConfigFromYaml(merged, base_path.string());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where + e.what());
+  }
+  if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);  // an empty base
+  root.remove("base");
+  OverlayYaml(merged, root);
+  return merged;
+}
+
+}  // namespace
+
+YAML::Node LoadOdometryYaml(const std::string& path) { return LoadOdometryYamlChain(path, 0); }
+
 OdometryConfig LoadOdometryConfig(const std::string& path) {
-  return OdometryConfigFromYaml(LoadYamlFile(path, "odometry config"), path);
+  return OdometryConfigFromYaml(LoadOdometryYaml(path), path);
 }
 
 }  // namespace ctlio::lio
