@@ -391,7 +391,9 @@ constexpr int kMaxBaseChain = 8;
 YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
   YAML::Node root = LoadYamlFile(path, "odometry config");
   const YAML::Node& read = root;
-  if (!read.IsMap() || !read["base"]) return root;
+  if (!read.IsMap() || !read["base"]) {
+    return root;
+  }
   const YAML::Node base_key = read["base"];
   const std::string where = YamlWhere(path, base_key.Mark()) + ": base: ";
   if (!base_key.IsScalar() || base_key.Scalar().empty()) {
@@ -402,7 +404,9 @@ YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
                              " files extend each other (a cycle?)");
   }
   std::filesystem::path base_path(base_key.Scalar());
-  if (base_path.is_relative()) base_path = std::filesystem::path(path).parent_path() / base_path;
+  if (base_path.is_relative()) {
+    base_path = std::filesystem::path(path).parent_path() / base_path;
+  }
   YAML::Node merged;
   try {
     merged = LoadOdometryYamlChain(base_path.string(), depth + 1);
@@ -410,7 +414,9 @@ YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
   } catch (const std::exception& e) {
     throw std::runtime_error(where + e.what());
   }
-  if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);  // an empty base
+  if (!merged.IsMap()) {
+    merged = YAML::Node(YAML::NodeType::Map);  // an empty base
+  }
   root.remove("base");
   OverlayYaml(merged, root);
   return merged;
