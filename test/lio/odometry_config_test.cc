@@ -260,6 +260,10 @@ TEST(OdometryConfig, BaseErrorsNameTheFiles) {
   WriteTemp("base_cycle_a.yaml", "base: base_cycle_b.yaml\n");
   m = message(WriteTemp("base_cycle_b.yaml", "base: base_cycle_a.yaml\n"));
   EXPECT_NE(m.find("extend each other"), std::string::npos) << m;
+  m = message(WriteTemp("base_device.yaml", "base: /dev/zero\n"));  // would never end
+  EXPECT_NE(m.find("/dev/zero is not a regular file"), std::string::npos) << m;
+  m = message(WriteTemp("base_folder.yaml", "base: .\n"));
+  EXPECT_NE(m.find("is not a regular file"), std::string::npos) << m;
   m = message(WriteTemp("base_list.yaml", "base: [a.yaml, b.yaml]\n"));
   EXPECT_NE(m.find("must be the path"), std::string::npos) << m;
   // A key of the extending file still names the extending file.

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <system_error>
 
 #include "ctlio/solvers/lio/yaml_io.h"
 
@@ -406,6 +407,12 @@ YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
   std::filesystem::path base_path(base_key.Scalar());
   if (base_path.is_relative()) {
     base_path = std::filesystem::path(path).parent_path() / base_path;
+  }
+  // A device or a folder named as the base would block or fail obscurely in the parser.
+  std::error_code error;
+  if (std::filesystem::exists(base_path, error) &&
+      !std::filesystem::is_regular_file(base_path, error)) {
+    throw std::runtime_error(where + base_path.string() + " is not a regular file");
   }
   YAML::Node merged;
   try {

@@ -183,7 +183,8 @@ OdometryConfig LoadOdometryConfig(const std::string& path);
 // makes the file extend another: the base is read (and checked on its own, so that its errors name
 // its own file and line), then this file's keys replace the base's mapping by mapping — a key
 // inside a section replaces that key only, a value or a list replaces the whole value — and the
-// result has no `base` key. Bases may chain, up to 8 files (a cycle is reported as too deep).
+// result has no `base` key. Bases may chain, up to 8 files (a cycle is reported as too deep); a
+// base must be a regular file (a device or a folder is refused before it is read).
 // Without `base` the file's YAML is returned as read. data/sim_lio_calibration.yaml extends
 // data/sim_lio.yaml this way.
 YAML::Node LoadOdometryYaml(const std::string& path);
