@@ -267,9 +267,9 @@ TEST(OdometryConfig, BaseErrorsNameTheFiles) {
   m = message(WriteTemp("base_list.yaml", "base: [a.yaml, b.yaml]\n"));
   EXPECT_NE(m.find("must be the path"), std::string::npos) << m;
   // A key of the extending file still names the extending file.
+  WriteTemp("base_plain.yaml", "window:\n  knots: 3\n");
   const std::string top_bad =
-      WriteTemp("base_top_bad.yaml", "base: overlay_root.yaml\nwindow:\n  overlap: 2x\n");
-  WriteTemp("overlay_root.yaml", "window:\n  knots: 3\n");
+      WriteTemp("base_top_bad.yaml", "base: base_plain.yaml\nwindow:\n  overlap: 2x\n");
   m = message(top_bad);
   EXPECT_NE(m.find(top_bad + ":3"), std::string::npos) << m;
 }

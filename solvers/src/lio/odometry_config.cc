@@ -391,7 +391,7 @@ constexpr int kMaxBaseChain = 8;
 
 YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
   YAML::Node root = LoadYamlFile(path, "odometry config");
-  const YAML::Node& read = root;
+  const YAML::Node& read = root;  // a non-const operator[] would add the key it looks up
   if (!read.IsMap() || !read["base"]) {
     return root;
   }
