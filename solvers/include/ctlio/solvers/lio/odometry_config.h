@@ -145,8 +145,8 @@ struct OdometryConfig {
   bool pose_covariance = false;
 
   // How many of the newest ScanResults LioOdometry::results() keeps (0: every one). Bounded so
-  // that the pipeline's memory does not grow with the length of the run (~1.3 kB a result);
-  // the odometry itself never reads them. Not a YAML key: a property of the caller.
+  // that the pipeline's memory does not grow with the length of the run (~1.1 kB a result and
+  // its notes); the odometry itself never reads them. Not a YAML key: a property of the caller.
   size_t kept_results = 100;
 
   // --- Online lidar–IMU calibration (top-level YAML section `calibration`, calibration_options.h;
