@@ -145,7 +145,21 @@ TEST(OdometryConfig, CalibrationSection) {
                 "  warmup_replay_passes: 2\n  warmup_replay_hold: true\n"));
   EXPECT_EQ(wp.calibration.warmup_replay_passes, 2);
   EXPECT_TRUE(wp.calibration.warmup_replay_hold);
-  for (const char* without_span : {"warmup_replay_passes: 2", "warmup_replay_hold: true"}) {
+  EXPECT_FALSE(wp.calibration.warmup_replay_freeze);
+  const OdometryConfig wf = LoadOdometryConfig(
+      WriteTemp("cal_wf.yaml",
+                "calibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 4\n"
+                "  warmup_replay_passes: 2\n  warmup_replay_freeze: true\n"));
+  EXPECT_TRUE(wf.calibration.warmup_replay_freeze);
+  EXPECT_FALSE(wf.calibration.warmup_replay_hold);
+  // The last pass either holds the span or freezes the values: not both.
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp(
+                   "cal_wfh.yaml",
+                   "calibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 4\n"
+                   "  warmup_replay_hold: true\n  warmup_replay_freeze: true\n")),
+               std::runtime_error);
+  for (const char* without_span :
+       {"warmup_replay_passes: 2", "warmup_replay_hold: true", "warmup_replay_freeze: true"}) {
     EXPECT_THROW(LoadOdometryConfig(
                      WriteTemp("cal_wps.yaml", std::string("calibration:\n  estimate_extrinsic: "
                                                            "true\n  ") +

@@ -194,6 +194,63 @@ TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
   EXPECT_TRUE(odometry.window().IsStateConstant(kGravityKey));
 }
 
+// Two passes, the last one frozen (calibration.warmup_replay_freeze): the second pass and
+// everything after it run with the values the first pass ended with as known values (no
+// calibration states), which is exactly the estimator configured with those values; every result
+// from the replay on reports them, held, with the σ the first pass ended with.
+TEST(WarmupReplay, FrozenLastPassIsTheEstimatorOfTheValuesItFroze) {
+  sim::SimulatedSource source(WrongStart(1.6));
+  OdometryConfig config = TwoPassesLastHeld(source);
+  config.calibration.warmup_replay_hold = false;
+  config.calibration.warmup_replay_freeze = true;
+  LioOdometry odometry(config);
+  int scans = 0, replayed_at = -1;
+  ScanResult replay;
+  ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));
+  ASSERT_GE(replayed_at, 9);
+  ASSERT_LE(replayed_at + 4, scans);
+  EXPECT_NE(replay.message.find("frozen"), std::string::npos) << replay.message;
+  // The carrying-on pipeline: known values, the first pass's estimates (not the live ones).
+  const OdometryConfig& frozen = odometry.config();
+  EXPECT_FALSE(frozen.calibration.any());
+  EXPECT_FALSE(odometry.window().HasState(kExtrinsicKey));
+  EXPECT_FALSE(odometry.window().HasState(TimeOffsetKey(0)));
+  const double live = odometry.warmup_results().back().calibration.time_offset_s.at(0);
+  const double value = frozen.calibration.TimeOffset(0);
+  EXPECT_LT(std::abs(value - 0.020), std::abs(live - 0.020));
+  EXPECT_GT((frozen.T_imu_lidar.translation() - config.T_imu_lidar.translation()).norm(), 0.01);
+  const std::deque<ScanResult>& results = odometry.results();
+  ASSERT_EQ(results.size(), static_cast<size_t>(scans));
+  const ScanResult::CalibrationEstimate& first = results.front().calibration;
+  ASSERT_EQ(first.time_offset_sigma_s.size(), 1u);
+  EXPECT_GT(first.time_offset_sigma_s[0], 0.0);
+  EXPECT_LT(first.time_offset_sigma_s[0], config.calibration.time_offset_prior_sigma_s);
+  EXPECT_GT(first.extrinsic_sigma.minCoeff(), 0.0);
+  for (size_t i = 0; i < results.size(); ++i) {
+    const ScanResult::CalibrationEstimate& c = results[i].calibration;
+    ASSERT_EQ(c.held.size(), 7u) << "scan " << i;
+    for (const bool h : c.held) EXPECT_TRUE(h) << "scan " << i;
+    EXPECT_EQ(c.time_offset_s.at(0), value) << "scan " << i;
+    EXPECT_TRUE(c.has_extrinsic);
+    EXPECT_EQ(c.T_imu_lidar.Matrix(), frozen.T_imu_lidar.Matrix()) << "scan " << i;
+    EXPECT_EQ(c.time_offset_sigma_s, first.time_offset_sigma_s) << "scan " << i;
+    EXPECT_EQ(c.extrinsic_sigma, first.extrinsic_sigma) << "scan " << i;
+  }
+  // The same data through a pipeline configured with the frozen values: the same poses.
+  OdometryConfig known = frozen;
+  known.kept_results = 0;
+  LioOdometry reference(known);
+  sim::SimulatedSource again(WrongStart(1.6));
+  int reference_scans = 0, none = -1;
+  ASSERT_NO_FATAL_FAILURE(FeedAll(&again, &reference, &reference_scans, &none, &replay));
+  EXPECT_EQ(none, -1);
+  ASSERT_EQ(reference_scans, scans);
+  for (size_t i = 0; i < results.size(); ++i) {
+    EXPECT_LT((results[i].T_mr.Matrix() - reference.results()[i].T_mr.Matrix()).norm(), 1e-9)
+        << "scan " << i;
+  }
+}
+
 // Slow motion (translation only, tuning sequence slow/100): the observability check finds the
 // lever arm unobservable, so its estimate after the warm-up is drift. The replay then starts
 // those coordinates from the configured (nominal) value and does not hold them; it holds the

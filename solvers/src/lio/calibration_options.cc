@@ -37,8 +37,12 @@ void CalibrationOptions::Validate() const {
   require(warmup_replay_passes >= 1 && warmup_replay_passes <= 10,
           "calibration.warmup_replay_passes must be in [1, 10]");
   // Without a replay span they would do nothing: say so rather than run without them.
-  require(warmup_replay_s > 0 || (warmup_replay_passes == 1 && !warmup_replay_hold),
-          "calibration.warmup_replay_passes / warmup_replay_hold need warmup_replay_s > 0");
+  require(warmup_replay_s > 0 ||
+              (warmup_replay_passes == 1 && !warmup_replay_hold && !warmup_replay_freeze),
+          "calibration.warmup_replay_passes / warmup_replay_hold / warmup_replay_freeze need "
+          "warmup_replay_s > 0");
+  require(!(warmup_replay_hold && warmup_replay_freeze),
+          "calibration.warmup_replay_hold and warmup_replay_freeze: choose one for the last pass");
 }
 
 std::vector<double> CalibrationOptions::PriorSigmas(int num_time_offsets, bool extrinsic) const {

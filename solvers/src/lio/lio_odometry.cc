@@ -172,7 +172,14 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
     }
     const bool hold = last && config_.calibration.warmup_replay_hold;
     if (hold) replay_config.calibration.hold_gravity = true;
+    const bool freeze = last && config_.calibration.warmup_replay_freeze;
+    if (freeze) {
+      // ReplayConfig has put the values into the configuration: known values from here on.
+      replay_config.calibration.estimate_time_offset = false;
+      replay_config.calibration.estimate_extrinsic = false;
+    }
     replay = std::make_unique<LioOdometry>(replay_config);
+    if (freeze) replay->frozen_calibration_ = Frozen(start_values, replay_config);
     if (hold) {
       // The replay's clock starts at the first kept scan's begin, so its scans end within span.
       replay->hold_calibration_until_s_ = span;
@@ -198,6 +205,10 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
        << " s processed again from the estimates after this scan";
   if (passes > 1) note << " (" << passes << " passes, each from the previous one's estimates)";
   if (config_.calibration.warmup_replay_hold) note << ", the calibration held over the span";
+  if (config_.calibration.warmup_replay_freeze) {
+    note << ", the calibration frozen at the values the " << (passes > 1 ? "pass before" : "live run")
+         << " ended with";
+  }
   AddNote(&replayed, note.str());
   replay->results_.back() = replayed;
   // The caller has re-read the span's results with this one: the configured bound holds again.
@@ -210,6 +221,19 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   *result = replayed;
 }
 
+ScanResult::CalibrationEstimate LioOdometry::Frozen(const ScanResult::CalibrationEstimate& estimate,
+                                                    const OdometryConfig& config) {
+  // The values the pipeline runs with (ReplayConfig's: an unobservable coordinate is back at its
+  // configured value), with the estimate's σ and observability.
+  ScanResult::CalibrationEstimate frozen = estimate;
+  for (size_t j = 0; j < frozen.time_offset_s.size(); ++j) {
+    frozen.time_offset_s[j] = config.calibration.TimeOffset(static_cast<int>(j));
+  }
+  if (frozen.has_extrinsic) frozen.T_imu_lidar = config.T_imu_lidar;
+  frozen.held.assign(frozen.time_offset_s.size() + (frozen.has_extrinsic ? 6 : 0), true);
+  return frozen;
+}
+
 OdometryConfig LioOdometry::ReplayConfig(const ScanResult::CalibrationEstimate& estimate) const {
   // The estimates become the replay's start values and prior means; the configured σ stays (the
   // replay uses the same data again, so it must not also be told it is sure of them). A
@@ -220,6 +244,7 @@ OdometryConfig LioOdometry::ReplayConfig(const ScanResult::CalibrationEstimate& 
   cal.warmup_replay_s = 0.0;  // the replay does not replay
   cal.warmup_replay_passes = 1;
   cal.warmup_replay_hold = false;
+  cal.warmup_replay_freeze = false;
   const std::vector<bool>& unobservable = estimate.unobservable;
   auto observable = [&](size_t i) { return i >= unobservable.size() || !unobservable[i]; };
   const size_t offsets = estimate.time_offset_s.size();
@@ -287,6 +312,8 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
                 " IMU sample(s) rejected since the previous scan (first: " + rejected.first + ")");
   }
   CheckFrozenImu(&result);
+  // After a frozen warm-up replay: the values this pipeline runs with, as the estimate.
+  if (frozen_calibration_) result.calibration = *frozen_calibration_;
   imu_.Trim(imu_.Seconds(last_scan_end_ns_) - 0.5);
   result.milliseconds = MsSince(start);
   result.cpu_ms = ThreadCpuMs() - cpu_start;

@@ -246,7 +246,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"hold_information", SetFromYaml(&o.hold_information)},
            {"warmup_replay_s", SetFromYaml(&o.warmup_replay_s)},
            {"warmup_replay_passes", SetFromYaml(&o.warmup_replay_passes)},
-           {"warmup_replay_hold", SetFromYaml(&o.warmup_replay_hold)}});
+           {"warmup_replay_hold", SetFromYaml(&o.warmup_replay_hold)},
+           {"warmup_replay_freeze", SetFromYaml(&o.warmup_replay_freeze)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

@@ -18,6 +18,7 @@
 #include <deque>
 #include <future>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -90,6 +91,10 @@ class LioOdometry {
   void MaybeReplayWarmup(ScanResult* result);
   // The config of a replay pass started from `estimate` (calibration.warmup_replay_s).
   OdometryConfig ReplayConfig(const ScanResult::CalibrationEstimate& estimate) const;
+  // What a frozen pass with `config` (ReplayConfig(estimate)) reports: its values, the
+  // estimate's σ, every coordinate marked held.
+  static ScanResult::CalibrationEstimate Frozen(const ScanResult::CalibrationEstimate& estimate,
+                                                const OdometryConfig& config);
   void CheckScan(const LidarScan& scan) const;
   // Input gate: the points timed outside [interval start − tolerance, end + tolerance]
   // (config.input.scan_time_tolerance; the interval starts at the previous scan's end once
@@ -202,6 +207,9 @@ class LioOdometry {
   // and which coordinates to hold (those observable when the pass started; empty: all).
   double hold_calibration_until_s_ = -1.0;
   std::vector<bool> hold_mask_;
+  // Set on the last pass of a frozen warm-up replay (calibration.warmup_replay_freeze): the
+  // values it runs with and their σ, reported with every result as held.
+  std::optional<ScanResult::CalibrationEstimate> frozen_calibration_;
   // The running map insertion (StartMapInsertion). Last: destroyed first, which waits for it
   // while the map and the points it reads still exist.
   std::future<double> map_insertion_;
