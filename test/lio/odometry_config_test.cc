@@ -213,9 +213,10 @@ TEST(OdometryConfig, CalibrationConfigExtendsTheSimConfig) {
   EXPECT_EQ(cal.frontend.max_keypoints, 2400);
   EXPECT_TRUE(cal.calibration.estimate_time_offset);
   EXPECT_TRUE(cal.calibration.estimate_extrinsic);
-  EXPECT_DOUBLE_EQ(cal.calibration.warmup_replay_s, 4.0);
+  EXPECT_DOUBLE_EQ(cal.calibration.warmup_replay_s, 12.0);
   EXPECT_EQ(cal.calibration.warmup_replay_passes, 2);
   EXPECT_TRUE(cal.calibration.warmup_replay_hold);
+  EXPECT_FALSE(cal.calibration.warmup_replay_freeze);
   // Untouched: the base's values (which differ from the struct's defaults).
   EXPECT_EQ(cal.qc, sim.qc);
   EXPECT_EQ(cal.alpha, sim.alpha);
