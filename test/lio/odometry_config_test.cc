@@ -153,10 +153,10 @@ TEST(OdometryConfig, CalibrationSection) {
   EXPECT_TRUE(wf.calibration.warmup_replay_freeze);
   EXPECT_FALSE(wf.calibration.warmup_replay_hold);
   // The last pass either holds the span or freezes the values: not both.
-  EXPECT_THROW(LoadOdometryConfig(WriteTemp(
-                   "cal_wfh.yaml",
-                   "calibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 4\n"
-                   "  warmup_replay_hold: true\n  warmup_replay_freeze: true\n")),
+  EXPECT_THROW(LoadOdometryConfig(
+                   WriteTemp("cal_wfh.yaml",
+                             "calibration:\n  estimate_extrinsic: true\n  warmup_replay_s: 4\n"
+                             "  warmup_replay_hold: true\n  warmup_replay_freeze: true\n")),
                std::runtime_error);
   for (const char* without_span :
        {"warmup_replay_passes: 2", "warmup_replay_hold: true", "warmup_replay_freeze: true"}) {

@@ -179,7 +179,9 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
       replay_config.calibration.estimate_extrinsic = false;
     }
     replay = std::make_unique<LioOdometry>(replay_config);
-    if (freeze) replay->frozen_calibration_ = Frozen(start_values, replay_config);
+    if (freeze) {
+      replay->frozen_calibration_ = Frozen(start_values, replay_config);
+    }
     if (hold) {
       // The replay's clock starts at the first kept scan's begin, so its scans end within span.
       replay->hold_calibration_until_s_ = span;
@@ -206,8 +208,8 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
   if (passes > 1) note << " (" << passes << " passes, each from the previous one's estimates)";
   if (config_.calibration.warmup_replay_hold) note << ", the calibration held over the span";
   if (config_.calibration.warmup_replay_freeze) {
-    note << ", the calibration frozen at the values the " << (passes > 1 ? "pass before" : "live run")
-         << " ended with";
+    note << ", the calibration frozen at the values the "
+         << (passes > 1 ? "pass before" : "live run") << " ended with";
   }
   AddNote(&replayed, note.str());
   replay->results_.back() = replayed;
@@ -229,7 +231,9 @@ ScanResult::CalibrationEstimate LioOdometry::Frozen(const ScanResult::Calibratio
   for (size_t j = 0; j < frozen.time_offset_s.size(); ++j) {
     frozen.time_offset_s[j] = config.calibration.TimeOffset(static_cast<int>(j));
   }
-  if (frozen.has_extrinsic) frozen.T_imu_lidar = config.T_imu_lidar;
+  if (frozen.has_extrinsic) {
+    frozen.T_imu_lidar = config.T_imu_lidar;
+  }
   frozen.held.assign(frozen.time_offset_s.size() + (frozen.has_extrinsic ? 6 : 0), true);
   return frozen;
 }
@@ -313,7 +317,9 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
   }
   CheckFrozenImu(&result);
   // After a frozen warm-up replay: the values this pipeline runs with, as the estimate.
-  if (frozen_calibration_) result.calibration = *frozen_calibration_;
+  if (frozen_calibration_) {
+    result.calibration = *frozen_calibration_;
+  }
   imu_.Trim(imu_.Seconds(last_scan_end_ns_) - 0.5);
   result.milliseconds = MsSince(start);
   result.cpu_ms = ThreadCpuMs() - cpu_start;
