@@ -82,11 +82,12 @@ struct CalibrationOptions {
   // The last pass runs with the calibration fixed at the values the pass before it ended with
   // (the live estimates with one pass): no calibration states, the estimator of known values,
   // and that pipeline carries on with them for the rest of the run; every later result reports
-  // them, with the marginal σ they had, as held. Why: estimating the calibration online costs
-  // accuracy by itself, not only from a wrong start: started at the true values, online
-  // estimation gave 1.14 / 1.06x the ATE of the values held (tuning sequences 100-109, medium /
-  // fast), while the values held 3 mm and 0.03 deg off gave 0.99x (README "Calibrate, then
-  // freeze"). Exclusive with warmup_replay_hold.
+  // them, with the marginal σ they had, as held. Why: after the span a scan costs what it costs
+  // with known values (~30 instead of ~70 ms on the tuning runs), and estimating after the span
+  // does not buy ATE (frozen and held after a 4 s span: 1.07 / 1.12x and 1.07 / 1.09x the true
+  // values', tuning sequences 100-109, medium / fast); but the final values are the span's (12 s:
+  // the lever arm within 1.00 cm, where held-then-estimated reaches 0.57 cm). README "A longer
+  // warm-up". Exclusive with warmup_replay_hold.
   bool warmup_replay_freeze = false;
   // Set by the held pass of a warm-up replay, not read from YAML: C_mi stays held (as with
   // window.estimate_gravity false and no extrinsic estimated) although the extrinsic is
