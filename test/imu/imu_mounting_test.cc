@@ -145,6 +145,39 @@ TEST(ImuMounting, DefaultMountingIsTheRobotFrame) {
   EXPECT_EQ(Evaluate(a, blocks.Accel()), Evaluate(b, blocks.Accel()));
 }
 
+// AccelResidual::ZeroingLinearAcceleration (the knots' initial guess, lio/imu_knot_prediction.h):
+// at the ϖ̇_v it returns the residual vanishes, for a rotated IMU on a lever arm, a correlated
+// covariance, both models and random states, and it moves with the measurement (one m/s² more
+// along the IMU's x is C_ri·e_x less of ϖ̇_v).
+TEST(ImuMounting, ZeroingLinearAccelerationZeroesTheResidual) {
+  std::mt19937 rng(29);
+  Mat3 cov;
+  cov << 2e-3, 5e-4, -2e-4, 5e-4, 1e-3, 1e-4, -2e-4, 1e-4, 3e-3;
+  for (int trial = 0; trial < 20; ++trial) {
+    const ImuMounting mounting = trial == 0 ? ImuMounting() : RandomMounting(rng, 0.5);
+    KnotState x;
+    x.pose = testing::RandomPose(rng, 3.0, 5.0);
+    x.velocity = testing::RandomVec6(rng, 2.0);
+    x.acceleration = testing::RandomVec6(rng, 10.0);
+    const Mat3 C_mi = testing::RandomPose(rng, 0.3, 0.0).rotation();
+    const Vec3 ba = testing::RandomVec6(rng, 0.1).head<3>();
+    const Vec3 meas = testing::RandomVec6(rng, 10.0).head<3>();
+    for (const AccelModel model : {AccelModel::kSpecificForce, AccelModel::kBodyCentric}) {
+      const internal::AccelResidual residual(meas, cov, 9.81, model, mounting);
+      KnotState zeroed = x;
+      zeroed.acceleration.head<3>() = residual.ZeroingLinearAcceleration(x, C_mi, ba);
+      EXPECT_LT(residual.Evaluate(zeroed, C_mi, ba, nullptr).norm(), 1e-9) << trial;
+      EXPECT_GT(residual.Evaluate(x, C_mi, ba, nullptr).norm(), 1.0) << trial;
+      const internal::AccelResidual shifted(meas + Vec3::UnitX(), cov, 9.81, model, mounting);
+      EXPECT_LT((shifted.ZeroingLinearAcceleration(x, C_mi, ba) - zeroed.acceleration.head<3>() +
+                 mounting.C_ri.col(0))
+                    .norm(),
+                1e-9)
+          << trial;
+    }
+  }
+}
+
 // Every Jacobian against GradientChecker with a rotated IMU on a 0.3–0.6 m lever arm: generic,
 // large-rotation (near π) and near-identity knots, both models, WNOJ and Singer.
 TEST(ImuMounting, JacobiansMatchNumericWithLeverArm) {

@@ -85,6 +85,14 @@ TEST(OdometryConfig, KnotsPerScan) {
       LoadOdometryConfig(WriteTemp("k2.yaml", "window:\n  knots_per_scan: 2\n")).knots_per_scan, 2);
 }
 
+TEST(OdometryConfig, ImuPrediction) {
+  EXPECT_FALSE(OdometryConfig().imu_prediction);
+  EXPECT_TRUE(
+      LoadOdometryConfig(WriteTemp("p.yaml", "window:\n  imu_prediction: true\n")).imu_prediction);
+  EXPECT_THROW(LoadOdometryConfig(WriteTemp("p2.yaml", "window:\n  imu_prediction: 3\n")),
+               std::runtime_error);
+}
+
 TEST(OdometryConfig, CalibrationSection) {
   // Off by default (and in the shipped configs).
   const OdometryConfig sim =

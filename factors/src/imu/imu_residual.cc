@@ -1,5 +1,7 @@
 #include "ctlio/factors/imu/imu_residual.h"
 
+#include <Eigen/LU>
+
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/priors/sqrt_information.h"
 
@@ -65,6 +67,14 @@ Vec3 AccelResidual::Evaluate(const gp::KnotState& x, const Mat3& C_mi, const Vec
     lin->g_m = g_m;
   }
   return sqrt_information_ * e;
+}
+
+Vec3 AccelResidual::ZeroingLinearAcceleration(const gp::KnotState& x, const Mat3& C_mi,
+                                              const Vec3& ba) const {
+  gp::KnotState x0 = x;
+  x0.acceleration.head<3>().setZero();
+  const Vec3 e0 = sqrt_information_.partialPivLu().solve(Evaluate(x0, C_mi, ba, nullptr));
+  return rotated_ ? Vec3(-(C_ir_.transpose() * e0)) : Vec3(-e0);
 }
 
 void InterpolateShifted(const gp::SingerModel<6>& model, double t_k, double t_k1, double stamp,

@@ -15,8 +15,10 @@
 #include "ctlio/factors/priors/euclidean_prior.h"
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/manifolds/pose_manifold.h"
+#include "ctlio/manifolds/rotation_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
 #include "ctlio/solvers/lio/continuous_lidar_term.h"
+#include "ctlio/solvers/lio/imu_knot_prediction.h"
 
 namespace ctlio::lio {
 
@@ -212,20 +214,10 @@ void GpKnotEstimator::AddKnotAndFactors(double t, SlidingWindow* window, ScanRes
     }
   }
 
-  // Initial guess: constant body velocity from the previous knot; with a gyro, the newest
-  // sample (of the first IMU that has one) gives the angular part (ϖ_φ = −C_ri(ω_meas − b_g),
-  // SPEC §1, imu_mounting.h).
-  Vec6 w = Eigen::Map<const Vec6>(prev.velocity);
-  for (int j = 0; j < num_imus(); ++j) {
-    if (imu[j].empty()) continue;
-    const Vec3 rate = imu[j].back().gyro - Eigen::Map<const Vec3>(prev.bias[j] + 3);
-    w.tail<3>() = mountings_[j].HasRotation() ? Vec3(-(mountings_[j].C_ri * rate)) : Vec3(-rate);
-    break;
-  }
   std::vector<Vec6> bias;
   for (const double* b : prev.bias) bias.push_back(Eigen::Map<const Vec6>(b));
-  knots_.push_back(
-      AddKnot(t, SE3::Exp(dt * w) * PoseManifold::Pose(prev.pose), w, Vec6::Zero(), bias, window));
+  const gp::KnotState guess = InitialGuess(prev, t, imu, *window);
+  knots_.push_back(AddKnot(t, guess.pose, guess.velocity, guess.acceleration, bias, window));
   const Knot& k = knots_.back();
 
   // GP prior between the knots (SPEC §2).
@@ -235,6 +227,45 @@ void GpKnotEstimator::AddKnotAndFactors(double t, SlidingWindow* window, ScanRes
                              {prev.keys.Bias(j), k.keys.Bias(j)});
     AddImuMeasurements(prev, k, j, imu[j], window, result);
   }
+}
+
+gp::KnotState GpKnotEstimator::InitialGuess(const Knot& prev, double t,
+                                            const std::vector<std::vector<ImuSample>>& imu,
+                                            const SlidingWindow& window) const {
+  gp::KnotState x = gp::ReadKnotState(prev.pose, prev.velocity, prev.acceleration);
+  const double dt = t - prev.t;
+  // The first IMU that has samples in the interval.
+  int j = 0;
+  while (j < num_imus() && imu[j].empty()) ++j;
+  if (j == num_imus()) {
+    // Constant body velocity, ϖ̇ = 0.
+    return {SE3::Exp(dt * x.velocity) * x.pose, x.velocity, Vec6::Zero()};
+  }
+  const Vec6 bias = Eigen::Map<const Vec6>(prev.bias[j]);
+  if (!config_.imu_prediction) {
+    // Constant body velocity from the previous knot, the angular part from the newest gyro
+    // sample (ϖ_φ = −C_ri(ω_meas − b_g), SPEC §1, imu_mounting.h).
+    Vec6 w = x.velocity;
+    w.tail<3>() = -(mountings_[j].C_ri * (imu[j].back().gyro - bias.tail<3>()));
+    return {SE3::Exp(dt * w) * x.pose, w, Vec6::Zero()};
+  }
+  // The samples integrated from the previous knot (imu_knot_prediction.h), at the times they
+  // measure (t + δ_j).
+  const double delta = time_offsets() ? TimeOffset(j, window) : 0.0;
+  std::vector<TimedImuSample> samples;
+  samples.reserve(imu[j].size());
+  for (const ImuSample& s : imu[j]) {
+    samples.push_back({imu_.Seconds(s.t_ns) + delta, s.gyro, s.accel});
+  }
+  ImuPredictionModel model;
+  model.mounting = mountings_[j];
+  model.gravity = config_.gravity;
+  model.accel_model = config_.exact_specific_force ? imu::AccelModel::kSpecificForce
+                                                   : imu::AccelModel::kBodyCentric;
+  model.has_accelerometer = config_.method == LioMethod::kSingerLio;
+  const Mat3 C_mi = model.has_accelerometer ? RotationManifold::Rotation(window.State(kGravityKey))
+                                            : Mat3::Identity();
+  return PredictKnotWithImu(x, prev.t, t, samples, bias, C_mi, model);
 }
 
 void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int imu_index,

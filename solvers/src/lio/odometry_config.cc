@@ -208,6 +208,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"threads", SetFromYaml(&c->solver_threads)},
                    {"overlap", SetFromYaml(&c->overlap_stages)},
                    {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
+                   {"imu_prediction", SetFromYaml(&c->imu_prediction)},
                    {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;

@@ -107,6 +107,10 @@ class AccelResidual {
   };
   // The residual; with `lin`, also D's parts.
   Vec3 Evaluate(const gp::KnotState& x, const Mat3& C_mi, const Vec3& ba, Linearisation* lin) const;
+  // The ϖ̇_v at which the residual vanishes, the rest of x as given: e is affine in ϖ̇_v with
+  // slope S·C_ir (D above), so ϖ̇_v = −C_ri S⁻¹ e(x with ϖ̇_v = 0). What the sample says the
+  // linear acceleration is (a knot's initial guess, lio/imu_knot_prediction.h).
+  Vec3 ZeroingLinearAcceleration(const gp::KnotState& x, const Mat3& C_mi, const Vec3& ba) const;
   // D·M (rows 3–5 δφ, 6–8 ϖ_v, 9–11 ϖ_ω, 12–14 ϖ̇_v, 15–17 ϖ̇_ω of M).
   template <typename Derived>
   Eigen::Matrix<double, 3, Derived::ColsAtCompileTime> Chain(

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/gp/motion_model.h"
 #include "ctlio/factors/imu/imu_mounting.h"
 #include "ctlio/solvers/lio/estimator.h"
@@ -84,6 +85,12 @@ class GpKnotEstimator final : public Estimator {
   // One knot at t after the newest, with the motion prior, bias walk and IMU measurements of the
   // interval between them.
   void AddKnotAndFactors(double t, SlidingWindow* window, ScanResult* result);
+  // The new knot's starting value at t from the previous knot and the interval's samples per
+  // IMU: window.imu_prediction's integration of the IMU (imu_knot_prediction.h), or constant
+  // body velocity with the newest gyro sample's rate.
+  gp::KnotState InitialGuess(const Knot& prev, double t,
+                             const std::vector<std::vector<ImuSample>>& imu,
+                             const SlidingWindow& window) const;
   // Gyro and accelerometer samples of IMU `imu` in (prev.t, k.t] as measurements (SPEC §3).
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,

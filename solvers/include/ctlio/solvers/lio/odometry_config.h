@@ -112,6 +112,11 @@ struct OdometryConfig {
   // the other writes). The same estimates, bit for bit.
   bool overlap_stages = false;
   bool estimate_gravity = false;  // hold C_mi after initialisation (paper) or refine it
+  // window.imu_prediction (the GP methods): a new knot starts from the previous one carried
+  // through the interval's IMU samples (imu_knot_prediction.h: ϖ_ω from each gyro sample, ϖ̇_v
+  // from each accelerometer sample, integrated), instead of constant body velocity with ϖ̇ = 0.
+  // Only the solver's starting point changes, not the problem.
+  bool imu_prediction = false;
 
   // --- Sensor setup.
   SE3 T_imu_lidar;  // lidar → robot (IMU) frame
