@@ -134,6 +134,7 @@ TEST(ImuKnotPrediction, TheOdometryFollowsTheMotionStart) {
   OdometryConfig config =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml");
   config.calibration = CalibrationOptions();
+  ASSERT_TRUE(config.imu_prediction);  // the calibration configuration starts from the IMU
   sim::SimConfig sequence = sim::ExperimentConfig(sim::Regime::kMedium, 100);
   sequence.duration_s = 1.0;
   sequence.lidar.beams = 16;

@@ -214,6 +214,8 @@ TEST(OdometryConfig, CalibrationConfigExtendsTheSimConfig) {
   const OdometryConfig cal =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml");
   EXPECT_EQ(cal.knots_per_scan, 2);
+  EXPECT_TRUE(cal.imu_prediction);
+  EXPECT_FALSE(sim.imu_prediction);
   EXPECT_DOUBLE_EQ(cal.accel_variance, 0.16);
   EXPECT_DOUBLE_EQ(cal.accel_loss_scale, 0.5);
   EXPECT_DOUBLE_EQ(cal.frontend.voxel_size, 0.5);

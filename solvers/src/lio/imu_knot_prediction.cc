@@ -36,7 +36,9 @@ gp::KnotState PredictKnotWithImu(const gp::KnotState& prev, double t_prev, doubl
     return Vec3(-(model.mounting.C_ri * (gyro - bg)));
   };
   gp::KnotState x = prev;
-  if (!model.has_accelerometer) x.acceleration.head<3>().setZero();
+  if (!model.has_accelerometer) {
+    x.acceleration.head<3>().setZero();
+  }
   // ϖ_ω at the knot and at each sample, and ϖ̇_ω at each sample as the slope of the quadratic
   // through it and its neighbours (the two before it at the last sample): the lever-arm term
   // ϖ̇_ω×p reads it, and a two-point quotient lags by half a sample (~4 m/s² at 0.3 m in the fast
@@ -92,7 +94,9 @@ gp::KnotState PredictKnotWithImu(const gp::KnotState& prev, double t_prev, doubl
   // After the last sample: ϖ̇ held, ϖ linear.
   const double h = t - now;
   Vec6 w1 = x.velocity;
-  if (model.has_accelerometer) w1.head<3>() += h * x.acceleration.head<3>();
+  if (model.has_accelerometer) {
+    w1.head<3>() += h * x.acceleration.head<3>();
+  }
   x.pose = Advance(x.pose, x.velocity, w1, h);
   x.velocity = w1;
   return x;
