@@ -120,6 +120,10 @@ DEFINE_bool(estimate_time_offset, false,
 DEFINE_string(time_offset, "",
               "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
               "mean when estimated, else applied as given");
+DEFINE_bool(calibration_keep_unobservable, true,
+            "calibration.yaml keeps the start value of every calibration coordinate that was "
+            "unobservable after more than half of the scans (its estimate is not a calibration); "
+            "false writes the last estimates as they are");
 DEFINE_string(sim_extrinsic_error, "",
               "--format sim: hand the odometry a NOMINAL extrinsic off the simulated one by "
               "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
@@ -367,7 +371,7 @@ int main(int argc, char** argv) {
         ev << "\n";
       }
       WriteExtrinsicEvaluation(run, ev);
-      lioapp::WriteObservabilitySummary(run, ev);
+      lioapp::WriteObservabilitySummary(run, ev, FLAGS_calibration_keep_unobservable);
       if (!run.nees.empty()) {
         ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
            << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "
@@ -402,7 +406,18 @@ int main(int argc, char** argv) {
         if (!run.warmup_live_scans.empty()) {
           lioapp::WriteCalibrationLog(out + "/calibration_live.csv", run, &run.warmup_live_scans);
         }
-        lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run);
+        lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run,
+                                     FLAGS_calibration_keep_unobservable);
+        if (const auto r = lioapp::RecommendCalibration(run, FLAGS_calibration_keep_unobservable);
+            r && !r->kept_at_start.empty()) {
+          std::string names;
+          for (const std::string& n : r->kept_at_start) {
+            names += " " + n;
+          }
+          LOG(WARNING) << "Calibration: unobservable after most scans (the motion did not excite "
+                          "them), written at their start values in "
+                       << out << "/calibration.yaml:" << names;
+        }
         if (const lio::ScanResult* last = lioapp::LastCalibration(run)) {
           const auto& c = last->calibration;
           for (size_t j = 0; j < c.time_offset_s.size(); ++j) {

@@ -37,7 +37,8 @@ void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c,
   }
 }
 
-void WriteObservabilitySummary(const RunSummary& run, std::ostream& out) {
+void WriteObservabilitySummary(const RunSummary& run, std::ostream& out,
+                               bool keep_unobservable_at_start) {
   const lio::ScanResult* last = LastCalibration(run);
   if (last == nullptr || !HasObservability(run)) return;
   const std::vector<std::string> names = CalibrationCoordinates(last->calibration);
@@ -58,7 +59,64 @@ void WriteObservabilitySummary(const RunSummary& run, std::ostream& out) {
   for (size_t i = 0; i < names.size() && i < fraction.size(); ++i) {
     out << ' ' << names[i] << '=' << fraction[i];
   }
+  out << "\ncalibration_kept_at_start";
+  const auto recommended = RecommendCalibration(run, keep_unobservable_at_start);
+  if (!recommended || recommended->kept_at_start.empty()) {
+    out << " -";
+  }
+  if (recommended) {
+    for (const std::string& name : recommended->kept_at_start) {
+      out << ' ' << name;
+    }
+  }
   out << "\n";
+}
+
+std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
+                                                           bool keep_unobservable_at_start) {
+  const lio::ScanResult* last = LastCalibration(run);
+  if (last == nullptr) {
+    return std::nullopt;
+  }
+  const auto& c = last->calibration;
+  RecommendedCalibration r;
+  r.time_offset_s = c.time_offset_s;
+  r.has_extrinsic = c.has_extrinsic;
+  r.T_imu_lidar = c.has_extrinsic ? c.T_imu_lidar : run.initial_extrinsic;
+  const std::vector<double> fraction =
+      keep_unobservable_at_start ? UnobservableFraction(run) : std::vector<double>();
+  const std::vector<std::string> names = CalibrationCoordinates(c);
+  if (fraction.size() != names.size()) {
+    return r;  // not assessed (the check off)
+  }
+  const auto keep = [&](size_t i) {
+    if (!(fraction[i] > kKeepAtStartUnobservableFraction)) {
+      return false;
+    }
+    r.kept_at_start.push_back(names[i]);
+    return true;
+  };
+  const size_t imus = r.time_offset_s.size();
+  for (size_t j = 0; j < imus; ++j) {
+    if (keep(j)) {
+      r.time_offset_s[j] = j < run.initial_time_offsets.size() ? run.initial_time_offsets[j] : 0.0;
+    }
+  }
+  if (r.has_extrinsic) {
+    // calibration.csv's coordinates: T = Exp([ρ; φ])·T_start (PoseManifold's left tangent).
+    Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
+    bool any = false;
+    for (size_t i = 0; i < 6; ++i) {
+      if (keep(imus + i)) {
+        d[static_cast<int>(i)] = 0.0;
+        any = true;
+      }
+    }
+    if (any) {
+      r.T_imu_lidar = SE3::Exp(d) * run.initial_extrinsic;
+    }
+  }
+  return r;
 }
 
 bool HasObservability(const RunSummary& run) {
@@ -159,30 +217,49 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
   io::CloseChecked(f, path);
 }
 
-bool WriteCalibrationYaml(const std::string& path, const RunSummary& run) {
+bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
+                          bool keep_unobservable_at_start) {
   const lio::ScanResult* last = LastCalibration(run);
-  if (last == nullptr) return false;
+  const auto recommended = RecommendCalibration(run, keep_unobservable_at_start);
+  if (last == nullptr || !recommended) {
+    return false;
+  }
   const auto& c = last->calibration;
+  const std::vector<std::string> names = CalibrationCoordinates(c);
+  const std::vector<double> fraction = UnobservableFraction(run);
   std::ofstream f = io::OpenForWriting(path);
   f << std::setprecision(9);
   f << "# Online calibration of " << run.method << " on " << run.source << " after "
     << 1e-9 * static_cast<double>(last->t_ns - run.scans.front().t_ns) << " s.\n"
     << "# Paste into the odometry config (README \"Online calibration\").\n";
-  if (!c.time_offset_s.empty()) {
-    for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
-      f << "# IMU " << j << ": time offset " << 1e3 * c.time_offset_s[j] << " ms, sigma "
-        << (j < c.time_offset_sigma_s.size() ? 1e3 * c.time_offset_sigma_s[j] : NAN) << " ms";
-      if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
-        f << ", truth " << 1e3 * *run.true_time_offsets[j] << " ms, error "
-          << 1e3 * (c.time_offset_s[j] - *run.true_time_offsets[j]) << " ms";
-      }
-      f << "\n";
+  if (!recommended->kept_at_start.empty()) {
+    f << "# NOT CALIBRATED (unobservable after more than "
+      << 100.0 * kKeepAtStartUnobservableFraction
+      << "% of the scans: the motion did not excite them), kept at the value the run started "
+         "from:";
+    for (const std::string& name : recommended->kept_at_start) {
+      const auto at = std::find(names.begin(), names.end(), name) - names.begin();
+      f << ' ' << name << " (" << 100.0 * fraction[static_cast<size_t>(at)] << "%)";
     }
+    f << ".\n# Calibrate them on a recording that rotates about every axis (README "
+         "\"Observability check\").\n";
+  }
+  for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
+    f << "# IMU " << j << ": time offset estimate " << 1e3 * c.time_offset_s[j] << " ms, sigma "
+      << (j < c.time_offset_sigma_s.size() ? 1e3 * c.time_offset_sigma_s[j] : NAN) << " ms";
+    if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
+      f << ", truth " << 1e3 * *run.true_time_offsets[j] << " ms, error "
+        << 1e3 * (c.time_offset_s[j] - *run.true_time_offsets[j]) << " ms";
+    }
+    if (recommended->time_offset_s[j] != c.time_offset_s[j]) {
+      f << "; written: " << 1e3 * recommended->time_offset_s[j] << " ms (the start)";
+    }
+    f << "\n";
   }
   if (!c.time_offset_s.empty()) {
     f << "calibration:\n  time_offset_s: [";
-    for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
-      f << (j > 0 ? ", " : "") << c.time_offset_s[j];
+    for (size_t j = 0; j < recommended->time_offset_s.size(); ++j) {
+      f << (j > 0 ? ", " : "") << recommended->time_offset_s[j];
     }
     f << "]\n";
   }
@@ -193,10 +270,10 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run) {
   const Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
   const Vec6& s = c.extrinsic_sigma;
   const double deg = 180.0 / M_PI;
-  e << std::setprecision(9) << "# Extrinsic T_imu_lidar: moved by rho = [" << d[0] << ", " << d[1]
-    << ", " << d[2] << "] m, phi = [" << deg * d[3] << ", " << deg * d[4] << ", " << deg * d[5]
-    << "] deg from the start; sigma [" << s[0] << ", " << s[1] << ", " << s[2] << "] m, ["
-    << deg * s[3] << ", " << deg * s[4] << ", " << deg * s[5] << "] deg";
+  e << std::setprecision(9) << "# Extrinsic T_imu_lidar estimate: moved by rho = [" << d[0] << ", "
+    << d[1] << ", " << d[2] << "] m, phi = [" << deg * d[3] << ", " << deg * d[4] << ", "
+    << deg * d[5] << "] deg from the start; sigma [" << s[0] << ", " << s[1] << ", " << s[2]
+    << "] m, [" << deg * s[3] << ", " << deg * s[4] << ", " << deg * s[5] << "] deg";
   if (run.true_extrinsic) {
     const Vec6 err = (c.T_imu_lidar * run.true_extrinsic->Inverse()).Log();
     const Vec6 t = (*run.true_extrinsic * run.initial_extrinsic.Inverse()).Log();
@@ -205,10 +282,22 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run) {
       << ", " << t[1] << ", " << t[2] << "] m, phi = [" << deg * t[3] << ", " << deg * t[4] << ", "
       << deg * t[5] << "] deg";
   }
+  const SE3& T = recommended->T_imu_lidar;
+  const Vec6 w = (T * run.initial_extrinsic.Inverse()).Log();
+  if (!w.isApprox(d)) {
+    e << "\n# Written (the unobservable axes at the start): rho = [" << w[0] << ", " << w[1] << ", "
+      << w[2] << "] m, phi = [" << deg * w[3] << ", " << deg * w[4] << ", " << deg * w[5]
+      << "] deg from the start";
+    if (run.true_extrinsic) {
+      const Vec6 err = (T * run.true_extrinsic->Inverse()).Log();
+      e << "; error vs truth " << 100.0 * err.head<3>().norm() << " cm, "
+        << deg * err.tail<3>().norm() << " deg";
+    }
+  }
   e << "\nextrinsic:\n  rotation: [";
-  const Mat3 R = c.T_imu_lidar.rotation();
+  const Mat3 R = T.rotation();
   for (int i = 0; i < 9; ++i) e << (i > 0 ? ", " : "") << R(i / 3, i % 3);
-  const Vec3 p = c.T_imu_lidar.translation();
+  const Vec3 p = T.translation();
   e << "]\n  translation: [" << p.x() << ", " << p.y() << ", " << p.z() << "]\n";
   io::CloseChecked(e, path);
   return true;

@@ -25,9 +25,11 @@ void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c,
                                   std::ostream& out);
 // Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
 // unobservable after the last scan, or -), calibration_information_final (ν per coordinate) and
-// calibration_unobservable_fraction (per coordinate, of the assessed scans). Nothing without the
-// observability check.
-void WriteObservabilitySummary(const RunSummary& run, std::ostream& out);
+// calibration_unobservable_fraction (per coordinate, of the assessed scans) and
+// calibration_kept_at_start (RecommendCalibration's, or -). Nothing without the observability
+// check.
+void WriteObservabilitySummary(const RunSummary& run, std::ostream& out,
+                               bool keep_unobservable_at_start = true);
 
 // Whether any scan carries the observability of the calibration (calibration_observability.h).
 bool HasObservability(const RunSummary& run);
@@ -45,8 +47,31 @@ std::vector<double> UnobservableFraction(const RunSummary& run);
 void WriteCalibrationLog(const std::string& path, const RunSummary& run,
                          const std::vector<lio::ScanResult>* scans = nullptr);
 
-// The final estimates (and σ, and the truth where the source knows it) as YAML comments around a
-// `calibration:` mapping with time_offset_s; false (nothing written) without an estimate.
-bool WriteCalibrationYaml(const std::string& path, const RunSummary& run);
+// A coordinate unobservable after more than this fraction of the assessed scans was never
+// calibrated by the run: its estimate is wherever the trajectory's errors pushed it (slow regime:
+// tens of degrees and centimetres from both the start and the truth, README "Observability
+// check"), so the values recommended for a config keep the start along it.
+inline constexpr double kKeepAtStartUnobservableFraction = 0.5;
+
+// The calibration a run recommends pasting into a config: the last estimate, except that with
+// `keep_unobservable_at_start` every coordinate unobservable after more than
+// kKeepAtStartUnobservableFraction of the assessed scans keeps the value the run started from
+// (δ_j: run.initial_time_offsets; the extrinsic's ρ / φ: the left-tangent components of
+// Log(T·T_start⁻¹) set to zero, as calibration.csv's coordinates). Nothing without an estimate.
+struct RecommendedCalibration {
+  std::vector<double> time_offset_s;  // per IMU [s]
+  bool has_extrinsic = false;
+  SE3 T_imu_lidar;
+  std::vector<std::string> kept_at_start;  // coordinate names (CalibrationCoordinates)
+};
+std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
+                                                           bool keep_unobservable_at_start = true);
+
+// The recommended calibration (RecommendCalibration; and the last estimate, σ and the truth where
+// the source knows it, as comments) as a `calibration:` mapping with time_offset_s and, with the
+// extrinsic estimated, an `extrinsic:` section; a comment names every coordinate kept at its
+// start. False (nothing written) without an estimate.
+bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
+                          bool keep_unobservable_at_start = true);
 
 }  // namespace ctlio::lioapp

@@ -285,6 +285,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
   run.initial_extrinsic = run.final_extrinsic = T_imu_lidar;
+  run.initial_time_offsets = config.calibration.time_offset_s;
   run.true_extrinsic = source.TrueImuFromLidar();
   const size_t total = options.max_scans > 0
                            ? (source.NumScans() > 0 ? std::min(options.max_scans, source.NumScans())

@@ -91,6 +91,9 @@ struct RunSummary {
   // The true clock offset of every IMU where the source knows it (simulator's stamp_offset), to
   // compare the online calibration's estimate with (ScanResult::calibration).
   std::vector<std::optional<double>> true_time_offsets;
+  // The clock offsets the run started from (config.calibration.time_offset_s; empty: 0 for
+  // every IMU), the start the online calibration moved from.
+  std::vector<double> initial_time_offsets;
   // Consistency (config.pose_covariance and ground truth): per estimated scan after the first,
   // the NEES of the pose, ε = Log(T_mr,true·T_mr⁻¹), εᵀΣ⁻¹ε (6 if consistent), and of its
   // translation and rotation parts alone (3 each), with T_mr,true anchored at the first scan.
