@@ -34,9 +34,9 @@ struct ImuPredictionModel {
 
 // The state at t > t_prev from the previous knot's (T_rm, ϖ, ϖ̇) at t_prev, the samples in
 // (t_prev, t] in time order (times outside are clamped into it), the IMU's bias [b_a; b_g] and
-// C_mi. Between samples ϖ̇_v is linear and ϖ_v integrates it (trapezoid), ϖ_ω is linear and
-// ϖ̇_ω its difference quotient; after the last sample ϖ_ω and ϖ̇ are held. Without samples: constant
-// ϖ and ϖ̇ = 0 (the guess without an IMU).
+// C_mi. Between samples ϖ̇_v is linear and ϖ_v integrates it (trapezoid), ϖ_ω is linear, and
+// ϖ̇_ω at a sample is the slope of the quadratic through it and its neighbours; after the last
+// sample ϖ_ω and ϖ̇ are held. Without samples: constant ϖ and ϖ̇ = 0 (the guess without an IMU).
 gp::KnotState PredictKnotWithImu(const gp::KnotState& prev, double t_prev, double t,
                                  const std::vector<TimedImuSample>& samples, const Vec6& bias,
                                  const Mat3& C_mi, const ImuPredictionModel& model);
