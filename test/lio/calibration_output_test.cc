@@ -50,18 +50,27 @@ RunSummary ConstructedRun(int scans, const std::vector<int>& unobservable_until,
   return run;
 }
 
-SE3 Pose(double a, double b, double c, double d, double e, double f) {
+// The start and the last estimate of the extrinsic in the constructed runs (non-trivial both).
+SE3 Start() {
   Vec6 x;
-  x << a, b, c, d, e, f;
+  x << 0.1, -0.05, 0.2, 0.3, -0.2, 1.0;
   return SE3::Exp(x);
+}
+SE3 Estimate() {
+  Vec6 x;
+  x << 0.03, 0.04, -0.02, 0.2, 0.1, -0.3;
+  return SE3::Exp(x) * Start();
+}
+
+// 11 scans, 10 assessed, δ started at 2 ms. δ: unobservable in 8 of 10 (kept); ρ_x in 6 (kept);
+// ρ_y in exactly 5 (not more than half: estimated); ρ_z never; φ_x in 10 (kept); φ_y, φ_z in 1.
+RunSummary MostlyUnobservableRun() {
+  return ConstructedRun(11, {9, 7, 6, 0, 11, 2, 2}, 0.002, Start(), Estimate());
 }
 
 TEST(CalibrationOutput, UnobservableAfterMostScansKeepsTheStart) {
-  const SE3 start = Pose(0.1, -0.05, 0.2, 0.3, -0.2, 1.0);
-  const SE3 estimate = Pose(0.03, 0.04, -0.02, 0.2, 0.1, -0.3) * start;
-  // 11 scans, 10 assessed. δ: unobservable in 8 of 10 (kept); ρ_x in 6 (kept); ρ_y in exactly
-  // 5 (not more than half: estimated); ρ_z never; φ_x in 10 (kept); φ_y, φ_z in 1.
-  const RunSummary run = ConstructedRun(11, {9, 7, 6, 0, 11, 2, 2}, 0.002, start, estimate);
+  const SE3 start = Start(), estimate = Estimate();
+  const RunSummary run = MostlyUnobservableRun();
   const auto r = RecommendCalibration(run);
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->kept_at_start,
@@ -89,9 +98,8 @@ TEST(CalibrationOutput, UnobservableAfterMostScansKeepsTheStart) {
 }
 
 TEST(CalibrationOutput, WithoutTheObservabilityCheckTheEstimateIsWritten) {
-  const SE3 start = Pose(0.1, -0.05, 0.2, 0.3, -0.2, 1.0);
-  const SE3 estimate = Pose(0.03, 0.04, -0.02, 0.2, 0.1, -0.3) * start;
-  const RunSummary run = ConstructedRun(5, {}, 0.0, start, estimate);
+  const SE3 estimate = Estimate();
+  const RunSummary run = ConstructedRun(5, {}, 0.0, Start(), estimate);
   const auto r = RecommendCalibration(run);
   ASSERT_TRUE(r.has_value());
   EXPECT_TRUE(r->kept_at_start.empty());
@@ -101,9 +109,7 @@ TEST(CalibrationOutput, WithoutTheObservabilityCheckTheEstimateIsWritten) {
 }
 
 TEST(CalibrationOutput, TheYamlIsTheRecommendationAndSaysWhatWasKept) {
-  const SE3 start = Pose(0.1, -0.05, 0.2, 0.3, -0.2, 1.0);
-  const SE3 estimate = Pose(0.03, 0.04, -0.02, 0.2, 0.1, -0.3) * start;
-  const RunSummary run = ConstructedRun(11, {9, 7, 6, 0, 11, 2, 2}, 0.002, start, estimate);
+  const RunSummary run = MostlyUnobservableRun();
   const auto r = RecommendCalibration(run);
   ASSERT_TRUE(r.has_value());
   const std::string path = (testing::FreshTempDir("calibration_output") / "c.yaml").string();
