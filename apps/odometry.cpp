@@ -338,6 +338,9 @@ int main(int argc, char** argv) {
         };
       }
       lioapp::RunSummary run = lioapp::RunOdometry(*source, config, options);
+      // The calibration.yaml values, also summarised in evaluation.txt.
+      const auto recommended =
+          lioapp::RecommendCalibration(run, FLAGS_calibration_keep_unobservable);
       if (FLAGS_progress) std::fprintf(stderr, "\n");
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       if (!run.dense.empty()) io::WriteTum(out + "/trajectory_dense.tum", run.dense);
@@ -371,7 +374,7 @@ int main(int argc, char** argv) {
         ev << "\n";
       }
       WriteExtrinsicEvaluation(run, ev);
-      lioapp::WriteObservabilitySummary(run, ev, FLAGS_calibration_keep_unobservable);
+      lioapp::WriteObservabilitySummary(run, recommended, ev);
       if (!run.nees.empty()) {
         ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
            << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "
@@ -406,12 +409,12 @@ int main(int argc, char** argv) {
         if (!run.warmup_live_scans.empty()) {
           lioapp::WriteCalibrationLog(out + "/calibration_live.csv", run, &run.warmup_live_scans);
         }
-        lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run,
-                                     FLAGS_calibration_keep_unobservable);
-        if (const auto r = lioapp::RecommendCalibration(run, FLAGS_calibration_keep_unobservable);
-            r && !r->kept_at_start.empty()) {
+        if (recommended) {
+          lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run, *recommended);
+        }
+        if (recommended && !recommended->kept_at_start.empty()) {
           std::string names;
-          for (const std::string& n : r->kept_at_start) {
+          for (const std::string& n : recommended->kept_at_start) {
             names += " " + n;
           }
           LOG(WARNING) << "Calibration: unobservable after most scans (the motion did not excite "

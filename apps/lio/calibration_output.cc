@@ -37,8 +37,9 @@ void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c,
   }
 }
 
-void WriteObservabilitySummary(const RunSummary& run, std::ostream& out,
-                               bool keep_unobservable_at_start) {
+void WriteObservabilitySummary(const RunSummary& run,
+                               const std::optional<RecommendedCalibration>& recommended,
+                               std::ostream& out) {
   const lio::ScanResult* last = LastCalibration(run);
   if (last == nullptr || !HasObservability(run)) return;
   const std::vector<std::string> names = CalibrationCoordinates(last->calibration);
@@ -60,7 +61,6 @@ void WriteObservabilitySummary(const RunSummary& run, std::ostream& out,
     out << ' ' << names[i] << '=' << fraction[i];
   }
   out << "\ncalibration_kept_at_start";
-  const auto recommended = RecommendCalibration(run, keep_unobservable_at_start);
   if (!recommended || recommended->kept_at_start.empty()) {
     out << " -";
   }
@@ -218,10 +218,9 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
 }
 
 bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
-                          bool keep_unobservable_at_start) {
+                          const RecommendedCalibration& recommended) {
   const lio::ScanResult* last = LastCalibration(run);
-  const auto recommended = RecommendCalibration(run, keep_unobservable_at_start);
-  if (last == nullptr || !recommended) {
+  if (last == nullptr) {
     return false;
   }
   const auto& c = last->calibration;
@@ -232,12 +231,12 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
   f << "# Online calibration of " << run.method << " on " << run.source << " after "
     << 1e-9 * static_cast<double>(last->t_ns - run.scans.front().t_ns) << " s.\n"
     << "# Paste into the odometry config (README \"Online calibration\").\n";
-  if (!recommended->kept_at_start.empty()) {
+  if (!recommended.kept_at_start.empty()) {
     f << "# NOT CALIBRATED (unobservable after more than "
       << 100.0 * kKeepAtStartUnobservableFraction
       << "% of the scans: the motion did not excite them), kept at the value the run started "
          "from:";
-    for (const std::string& name : recommended->kept_at_start) {
+    for (const std::string& name : recommended.kept_at_start) {
       const auto at = std::find(names.begin(), names.end(), name) - names.begin();
       f << ' ' << name << " (" << 100.0 * fraction[static_cast<size_t>(at)] << "%)";
     }
@@ -251,15 +250,15 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
       f << ", truth " << 1e3 * *run.true_time_offsets[j] << " ms, error "
         << 1e3 * (c.time_offset_s[j] - *run.true_time_offsets[j]) << " ms";
     }
-    if (recommended->time_offset_s[j] != c.time_offset_s[j]) {
-      f << "; written: " << 1e3 * recommended->time_offset_s[j] << " ms (the start)";
+    if (recommended.time_offset_s[j] != c.time_offset_s[j]) {
+      f << "; written: " << 1e3 * recommended.time_offset_s[j] << " ms (the start)";
     }
     f << "\n";
   }
   if (!c.time_offset_s.empty()) {
     f << "calibration:\n  time_offset_s: [";
-    for (size_t j = 0; j < recommended->time_offset_s.size(); ++j) {
-      f << (j > 0 ? ", " : "") << recommended->time_offset_s[j];
+    for (size_t j = 0; j < recommended.time_offset_s.size(); ++j) {
+      f << (j > 0 ? ", " : "") << recommended.time_offset_s[j];
     }
     f << "]\n";
   }
@@ -282,7 +281,7 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
       << ", " << t[1] << ", " << t[2] << "] m, phi = [" << deg * t[3] << ", " << deg * t[4] << ", "
       << deg * t[5] << "] deg";
   }
-  const SE3& T = recommended->T_imu_lidar;
+  const SE3& T = recommended.T_imu_lidar;
   const Vec6 w = (T * run.initial_extrinsic.Inverse()).Log();
   if (!w.isApprox(d)) {
     e << "\n# Written (the unobservable axes at the start): rho = [" << w[0] << ", " << w[1] << ", "

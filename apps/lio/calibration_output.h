@@ -23,14 +23,6 @@ std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::Calibrati
 // "nan,-" where it was not assessed (the initialising scan, the check off).
 void WriteCoordinateObservability(const lio::ScanResult::CalibrationEstimate& c, size_t i,
                                   std::ostream& out);
-// Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
-// unobservable after the last scan, or -), calibration_information_final (ν per coordinate) and
-// calibration_unobservable_fraction (per coordinate, of the assessed scans) and
-// calibration_kept_at_start (RecommendCalibration's, or -). Nothing without the observability
-// check.
-void WriteObservabilitySummary(const RunSummary& run, std::ostream& out,
-                               bool keep_unobservable_at_start = true);
-
 // Whether any scan carries the observability of the calibration (calibration_observability.h).
 bool HasObservability(const RunSummary& run);
 // Per calibration coordinate (as ScanResult::CalibrationEstimate::observability): the fraction
@@ -67,11 +59,19 @@ struct RecommendedCalibration {
 std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
                                                            bool keep_unobservable_at_start = true);
 
-// The recommended calibration (RecommendCalibration; and the last estimate, σ and the truth where
-// the source knows it, as comments) as a `calibration:` mapping with time_offset_s and, with the
+// Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
+// unobservable after the last scan, or -), calibration_information_final (ν per coordinate),
+// calibration_unobservable_fraction (per coordinate, of the assessed scans) and
+// calibration_kept_at_start (`recommended`'s, or -). Nothing without the observability check.
+void WriteObservabilitySummary(const RunSummary& run,
+                               const std::optional<RecommendedCalibration>& recommended,
+                               std::ostream& out);
+
+// `recommended` (RecommendCalibration of `run`; and the last estimate, σ and the truth where the
+// source knows it, as comments) as a `calibration:` mapping with time_offset_s and, with the
 // extrinsic estimated, an `extrinsic:` section; a comment names every coordinate kept at its
 // start. False (nothing written) without an estimate.
 bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
-                          bool keep_unobservable_at_start = true);
+                          const RecommendedCalibration& recommended);
 
 }  // namespace ctlio::lioapp

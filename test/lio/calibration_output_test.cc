@@ -113,7 +113,7 @@ TEST(CalibrationOutput, TheYamlIsTheRecommendationAndSaysWhatWasKept) {
   const auto r = RecommendCalibration(run);
   ASSERT_TRUE(r.has_value());
   const std::string path = (testing::FreshTempDir("calibration_output") / "c.yaml").string();
-  ASSERT_TRUE(WriteCalibrationYaml(path, run));
+  ASSERT_TRUE(WriteCalibrationYaml(path, run, *r));
   std::ifstream in(path);
   std::stringstream text;
   text << in.rdbuf();
@@ -134,7 +134,7 @@ TEST(CalibrationOutput, TheYamlIsTheRecommendationAndSaysWhatWasKept) {
         << i;
   }
   std::ostringstream summary;
-  WriteObservabilitySummary(run, summary);
+  WriteObservabilitySummary(run, r, summary);
   EXPECT_NE(summary.str().find(
                 "calibration_kept_at_start time_offset_0 extrinsic_rho_x extrinsic_phi_x\n"),
             std::string::npos)
