@@ -83,6 +83,8 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
   r.time_offset_s = c.time_offset_s;
   r.has_extrinsic = c.has_extrinsic;
   r.T_imu_lidar = c.has_extrinsic ? c.T_imu_lidar : run.initial_extrinsic;
+  // calibration.csv's coordinates: T = Exp([ρ; φ])·T_start (PoseManifold's left tangent).
+  r.extrinsic_from_start = (r.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
   const std::vector<double> fraction =
       keep_unobservable_at_start ? UnobservableFraction(run) : std::vector<double>();
   const std::vector<std::string> names = CalibrationCoordinates(c);
@@ -103,17 +105,15 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
     }
   }
   if (r.has_extrinsic) {
-    // calibration.csv's coordinates: T = Exp([ρ; φ])·T_start (PoseManifold's left tangent).
-    Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
     bool any = false;
     for (size_t i = 0; i < 6; ++i) {
       if (keep(imus + i)) {
-        d[static_cast<int>(i)] = 0.0;
+        r.extrinsic_from_start[static_cast<int>(i)] = 0.0;
         any = true;
       }
     }
     if (any) {
-      r.T_imu_lidar = SE3::Exp(d) * run.initial_extrinsic;
+      r.T_imu_lidar = SE3::Exp(r.extrinsic_from_start) * run.initial_extrinsic;
     }
   }
   return r;
@@ -238,7 +238,7 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
          "from:";
     for (const std::string& name : recommended.kept_at_start) {
       const auto at = std::find(names.begin(), names.end(), name) - names.begin();
-      f << ' ' << name << " (" << 100.0 * fraction[static_cast<size_t>(at)] << "%)";
+      f << ' ' << name << " (" << std::lround(100.0 * fraction[static_cast<size_t>(at)]) << "%)";
     }
     f << ".\n# Calibrate them on a recording that rotates about every axis (README "
          "\"Observability check\").\n";
@@ -282,8 +282,8 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
       << deg * t[5] << "] deg";
   }
   const SE3& T = recommended.T_imu_lidar;
-  const Vec6 w = (T * run.initial_extrinsic.Inverse()).Log();
-  if (!w.isApprox(d)) {
+  const Vec6& w = recommended.extrinsic_from_start;
+  if (w != d) {
     e << "\n# Written (the unobservable axes at the start): rho = [" << w[0] << ", " << w[1] << ", "
       << w[2] << "] m, phi = [" << deg * w[3] << ", " << deg * w[4] << ", " << deg * w[5]
       << "] deg from the start";

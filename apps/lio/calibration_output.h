@@ -54,7 +54,8 @@ struct RecommendedCalibration {
   std::vector<double> time_offset_s;  // per IMU [s]
   bool has_extrinsic = false;
   SE3 T_imu_lidar;
-  std::vector<std::string> kept_at_start;  // coordinate names (CalibrationCoordinates)
+  Vec6 extrinsic_from_start = Vec6::Zero();  // [ρ; φ] of T_imu_lidar from the start, kept axes 0
+  std::vector<std::string> kept_at_start;    // coordinate names (CalibrationCoordinates)
 };
 std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
                                                            bool keep_unobservable_at_start = true);

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/sim_lio.h"
@@ -68,6 +69,17 @@ RunSummary MostlyUnobservableRun() {
   return ConstructedRun(11, {9, 7, 6, 0, 11, 2, 2}, 0.002, Start(), Estimate());
 }
 
+// calibration.yaml of `run` with `recommended`, written to a fresh folder: its path and text.
+std::pair<std::string, std::string> WrittenYaml(const RunSummary& run,
+                                                const RecommendedCalibration& recommended) {
+  const std::string path = (testing::FreshTempDir("calibration_output") / "c.yaml").string();
+  EXPECT_TRUE(WriteCalibrationYaml(path, run, recommended));
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return {path, text.str()};
+}
+
 TEST(CalibrationOutput, UnobservableAfterMostScansKeepsTheStart) {
   const SE3 start = Start(), estimate = Estimate();
   const RunSummary run = MostlyUnobservableRun();
@@ -106,21 +118,26 @@ TEST(CalibrationOutput, WithoutTheObservabilityCheckTheEstimateIsWritten) {
   EXPECT_EQ(r->time_offset_s[0], 0.0123);
   EXPECT_TRUE((r->T_imu_lidar * estimate.Inverse()).Log().norm() < 1e-12);
   EXPECT_FALSE(RecommendCalibration(RunSummary()).has_value());
+  // Nothing kept: the yaml neither warns nor has a second, written extrinsic.
+  const auto [path, text] = WrittenYaml(run, *r);
+  EXPECT_EQ(text.find("NOT CALIBRATED"), std::string::npos) << text;
+  EXPECT_EQ(text.find("# Written"), std::string::npos) << text;
 }
 
 TEST(CalibrationOutput, TheYamlIsTheRecommendationAndSaysWhatWasKept) {
   const RunSummary run = MostlyUnobservableRun();
   const auto r = RecommendCalibration(run);
   ASSERT_TRUE(r.has_value());
-  const std::string path = (testing::FreshTempDir("calibration_output") / "c.yaml").string();
-  ASSERT_TRUE(WriteCalibrationYaml(path, run, *r));
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_NE(text.str().find("# NOT CALIBRATED"), std::string::npos) << text.str();
-  EXPECT_NE(text.str().find("time_offset_0 (80%) extrinsic_rho_x (60%) extrinsic_phi_x (100%)"),
+  const auto [path, text] = WrittenYaml(run, *r);
+  EXPECT_NE(text.find("# NOT CALIBRATED"), std::string::npos) << text;
+  EXPECT_NE(text.find("time_offset_0 (80%) extrinsic_rho_x (60%) extrinsic_phi_x (100%)"),
             std::string::npos)
-      << text.str();
+      << text;
+  // The written extrinsic's comment: the kept axes exactly at the start (ρ_x, φ_x).
+  EXPECT_NE(text.find("# Written (the unobservable axes at the start): rho = [0, "),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("m, phi = [0, "), std::string::npos) << text;
   // What a config reads from it is the recommendation (9 significant digits).
   const YAML::Node y = YAML::LoadFile(path);
   EXPECT_NEAR(y["calibration"]["time_offset_s"][0].as<double>(), 0.002, 1e-12);
