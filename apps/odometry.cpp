@@ -14,7 +14,7 @@
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
 // --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time, the degenerate
-// directions of the lidar term: README "Degeneracy") and, when the
+// directions of the lidar term: docs/user-guide/outputs.md) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
 // alignment) and DIR/pose_errors.csv. Plots (tools/plot_odometry.py, python3-matplotlib):
 // DIR/odometry.png (top and side view in metres, errors and per-scan time/status over time) and,
@@ -23,7 +23,7 @@
 // and print their ATE side by side. Every write is checked (a full disk or an unwritable path is
 // an error naming the path, exit 2); the odometry's input gates (lio/input_checks.h, config section
 // `input:`) are reported in scans.log, evaluation.txt and the summary, and --max_imu_gap_error
-// makes IMU gaps in the dataset files an error instead of a warning (README, "IMU gaps").
+// makes IMU gaps in the dataset files an error instead of a warning (docs/user-guide/bad-input.md).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
@@ -285,7 +285,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string> methods = Split(FLAGS_method);
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
-    // An `extrinsic:` written in the config wins over the dataset's (precedence in README).
+    // An `extrinsic:` written in the config wins over the dataset's (precedence:
+    // docs/user-guide/configuration.md).
     bool config_extrinsic = false;
     if (!FLAGS_config.empty()) {
       const YAML::Node root = lio::LoadOdometryYaml(FLAGS_config);

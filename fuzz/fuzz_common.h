@@ -1,4 +1,4 @@
-// Shared helpers of the libFuzzer targets (fuzz/README in the project README, "Fuzzing"): every
+// Shared helpers of the libFuzzer targets (docs/developer-guide/fuzzing.md): every
 // target writes the fuzzer's bytes into files of a per-process scratch folder and runs one reader
 // on them. A reader may throw std::exception (a clear error); anything else — a crash, a
 // sanitizer report, another exception type, a hang — is a finding.

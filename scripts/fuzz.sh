@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 build_dir=${2:-build-fuzz}
 # rosbag: RosbagSource over Debian's uninstrumented librosbag, behind ctlio's bag structure check
-# (README "Fuzzing"); 5 minutes clean when it was added.
+# (docs/developer-guide/fuzzing.md); 5 minutes clean when it was added.
 targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config euroc rosbag"}
 bash scripts/install_deps.sh
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""One picture of a worlds x regimes experiment (README "Worlds x regimes with degeneracy"):
+"""One picture of a worlds x regimes experiment (docs/experiments/worlds-and-degeneracy.md):
 per cell (world / regime) and method, the RMSE ATE over the runs that did not fail, the mean
 drift per 100 m over the same runs, and the median CPU ms per scan; failed runs are written
 above the bars ("3/10 failed"), a cell where every run failed gets an "x" at the top.

@@ -230,7 +230,7 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
   f << std::setprecision(9);
   f << "# Online calibration of " << run.method << " on " << run.source << " after "
     << 1e-9 * static_cast<double>(last->t_ns - run.scans.front().t_ns) << " s.\n"
-    << "# Paste into the odometry config (README \"Online calibration\").\n";
+    << "# Paste into the odometry config (docs/user-guide/calibration.md).\n";
   if (!recommended.kept_at_start.empty()) {
     f << "# NOT CALIBRATED (unobservable after more than "
       << 100.0 * kKeepAtStartUnobservableFraction
@@ -240,8 +240,8 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
       const auto at = std::find(names.begin(), names.end(), name) - names.begin();
       f << ' ' << name << " (" << std::lround(100.0 * fraction[static_cast<size_t>(at)]) << "%)";
     }
-    f << ".\n# Calibrate them on a recording that rotates about every axis (README "
-         "\"Observability check\").\n";
+    f << ".\n# Calibrate them on a recording that rotates about every axis "
+         "(docs/user-guide/calibration.md).\n";
   }
   for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
     f << "# IMU " << j << ": time offset estimate " << 1e3 * c.time_offset_s[j] << " ms, sigma "

@@ -41,8 +41,8 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
 
 // A coordinate unobservable after more than this fraction of the assessed scans was never
 // calibrated by the run: its estimate is wherever the trajectory's errors pushed it (slow regime:
-// tens of degrees and centimetres from both the start and the truth, README "Observability
-// check"), so the values recommended for a config keep the start along it.
+// tens of degrees and centimetres from both the start and the truth, docs/experiments/
+// calibration.md), so the values recommended for a config keep the start along it.
 inline constexpr double kKeepAtStartUnobservableFraction = 0.5;
 
 // The calibration a run recommends pasting into a config: the last estimate, except that with

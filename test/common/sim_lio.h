@@ -12,11 +12,11 @@
 
 namespace ctlio::testing {
 
-// data/sim_lio.yaml, the config of the simulated experiments (README), with the subsampling of
-// the reduced sensors the tests simulate (16-32 beams, every 4th-8th firing): the shipped 0.8 m
-// is tuned for the full-resolution sweep and leaves these sparse sweeps too few keypoints; 0.5 m
-// is what the config's comment prescribes for them (and what the README's reduced-sensor tables
-// were measured with).
+// data/sim_lio.yaml, the config of the simulated experiments (docs/experiments), with the
+// subsampling of the reduced sensors the tests simulate (16-32 beams, every 4th-8th firing): the
+// shipped 0.8 m is tuned for the full-resolution sweep and leaves these sparse sweeps too few
+// keypoints; 0.5 m is what the config's comment prescribes for them (and what the reduced-sensor
+// tables of docs/experiments were measured with).
 inline lio::OdometryConfig SimLioConfig() {
   lio::OdometryConfig config =
       lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
@@ -34,10 +34,10 @@ inline lio::OdometryConfig SimLioConfig() {
   return config;
 }
 
-// Tuning sequence `regime`/100 (not one of the README's reported indices 0–9) for `duration_s`,
-// reduced lidar (16 beams, every 4th firing), with the calibration the tests start wrong from:
-// a nominal extrinsic 3° / 10 cm off the truth (axis and direction drawn for index 100) and the
-// IMU's stamps late by `imu_stamp_offset_s`.
+// Tuning sequence `regime`/100 (not one of the reported indices 0–9 of docs/experiments) for
+// `duration_s`, reduced lidar (16 beams, every 4th firing), with the calibration the tests start
+// wrong from: a nominal extrinsic 3° / 10 cm off the truth (axis and direction drawn for index 100)
+// and the IMU's stamps late by `imu_stamp_offset_s`.
 inline sim::SimConfig WrongCalibrationSequence(sim::Regime regime, double duration_s,
                                                double imu_stamp_offset_s) {
   sim::SimConfig c = sim::ExperimentConfig(regime, 100);

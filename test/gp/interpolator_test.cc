@@ -482,7 +482,7 @@ TEST(GpInterpolatorRowsTest, SelectedRowsMatchNumeric) {
 // differences over τ). SPEC §2 gives ϖ̇ = J(ξ̈ + ½ξ̇^⋏ϖ); the exact derivative of ϖ = J(ξ)ξ̇ is
 // Jξ̈ + ∂(Jξ̇)/∂ξ·ξ̇. Their difference is (1/6 − 1/4)·ξ̇^⋏ξ^⋏ξ̇ + O(|ξ|²|ξ̇|²): zero along a fixed
 // twist direction (ξ ∥ ξ̇) and second order otherwise. This test pins down which one the code
-// computes and how large the difference is (see the README's IMU section).
+// computes and how large the difference is (see docs/experiments/euroc.md).
 TEST(GpInterpolatorTest, AccelerationVersusDerivativeOfVelocity) {
   std::mt19937 rng(29);
   const SingerModel<6> model = ctlio::testing::NewerCollegeSingerModel();

@@ -1,8 +1,8 @@
 // Dataset folders (SPEC §6–7): the simulator written in the Newer College 2020 layout and in
 // ctlio's own layout and read back through the one DataSource interface (end to end), the real
-// KITTI sample, and every bad input of the README's bad-input table: missing folders/files,
-// malformed CSV lines, PCD without a time field, scans out of order, IMU time going backwards or
-// duplicated, IMU gaps.
+// KITTI sample, and every bad input of the bad-input table of docs/user-guide/bad-input.md: missing
+// folders/files, malformed CSV lines, PCD without a time field, scans out of order, IMU time going
+// backwards or duplicated, IMU gaps.
 #include "ctlio/io/dataset.h"
 
 #include <gmock/gmock.h>

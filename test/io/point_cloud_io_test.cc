@@ -1,6 +1,6 @@
 // Point-cloud files: round trips through PCD/PLY/.bin, the real Newer College sweep files of
-// ../shared/data, and every bad input of the README's bad-input table that concerns a single
-// cloud.
+// ../shared/data, and every bad input of the bad-input table of docs/user-guide/bad-input.md that
+// concerns a single cloud.
 #include "ctlio/io/point_cloud_io.h"
 
 #include <gmock/gmock.h>

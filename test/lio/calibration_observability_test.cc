@@ -1,9 +1,9 @@
 // Observability of the online calibration from the measurements alone
-// (calibration_observability.h, README "Online calibration"): the horizon's whitened information
-// per coordinate (unit level), and end to end on short simulated sequences (tuning index 100, 16
-// beams, every 4th firing, both calibrations from the wrong start): the slow regime (translation
-// only) leaves the clock offset and the extrinsic's translation unobservable — detected, held,
-// no drift — while the medium regime observes them.
+// (calibration_observability.h, docs/experiments/calibration.md): the horizon's whitened
+// information per coordinate (unit level), and end to end on short simulated sequences (tuning
+// index 100, 16 beams, every 4th firing, both calibrations from the wrong start): the slow regime
+// (translation only) leaves the clock offset and the extrinsic's translation unobservable —
+// detected, held, no drift — while the medium regime observes them.
 #include "ctlio/solvers/lio/calibration_observability.h"
 
 #include <gtest/gtest.h>
@@ -95,7 +95,7 @@ lioapp::RunSummary RunBoth(sim::Regime regime, double duration_s, bool two_knots
   config.calibration.estimate_time_offset = true;
   config.calibration.estimate_extrinsic = true;
   if (two_knots) {
-    // The calibration runs' configuration (README "Online calibration"), not held: δ moves.
+    // The calibration runs' configuration (docs/experiments/calibration.md), not held: δ moves.
     config.knots_per_scan = 2;
     config.accel_variance = 0.16;
   } else {

@@ -1,8 +1,8 @@
-// The calibration a run recommends for a config (calibration_output.h, README "Observability
-// check"): coordinates unobservable after most scans keep their start value instead of the
-// estimate that drifted, in RecommendCalibration and in the calibration.yaml a user pastes; on
-// constructed runs, and end to end in the slow regime (translation only), where the estimate
-// drifts while the start is kept.
+// The calibration a run recommends for a config (calibration_output.h,
+// docs/user-guide/calibration.md): coordinates unobservable after most scans keep their start value
+// instead of the estimate that drifted, in RecommendCalibration and in the calibration.yaml a user
+// pastes; on constructed runs, and end to end in the slow regime (translation only), where the
+// estimate drifts while the start is kept.
 #include "lio/calibration_output.h"
 
 #include <gtest/gtest.h>

@@ -1,11 +1,11 @@
-// Degeneracy end to end (README "Degeneracy"): short, reduced runs (3 s, 16 beams, every 4th
-// firing) of the walking regime in the corridor and the park, sequence index 100 (the experiment
-// reports indices 0–9). In the corridor the lidar term leaves the axis unconstrained: every
-// method detects it per scan; Singer-LIO, the baseline and lidar_gyro stay `ok` (the prior and
-// the IMU carry the axis, with more information along it than the lidar) and within the stated
-// drift; lidar_only reports the scans `degenerate` and keeps its prediction along the axis
-// instead of inventing motion. In the park Singer-LIO stays within its drift bound and lidar_only
-// is flagged.
+// Degeneracy end to end (docs/experiments/worlds-and-degeneracy.md): short, reduced runs (3 s, 16
+// beams, every 4th firing) of the walking regime in the corridor and the park, sequence index 100
+// (the experiment reports indices 0–9). In the corridor the lidar term leaves the axis
+// unconstrained: every method detects it per scan; Singer-LIO, the baseline and lidar_gyro stay
+// `ok` (the prior and the IMU carry the axis, with more information along it than the lidar) and
+// within the stated drift; lidar_only reports the scans `degenerate` and keeps its prediction along
+// the axis instead of inventing motion. In the park Singer-LIO stays within its drift bound and
+// lidar_only is flagged.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,13 +49,13 @@ Counts Count(const lioapp::RunSummary& run) {
   return c;
 }
 
-// Measured on this sequence (README "Degeneracy"): degenerate directions (all along the axis) in
-// 12 / 14 / 15 of 29 registered scans (singer_lio / imu_input / lidar_gyro; the corner behind the
-// start constrains the axis in the others); whitened information along the axis, median of the
-// flagged scans, prior vs lidar: 8.7e3 vs 522 (Singer-LIO), 533 vs 162 (baseline), 9.2 vs 207
-// (lidar_gyro: no accelerometer, only the GP prior holds the axis); ATE 0.018 / 0.28 / 0.10 m,
-// drift per 100 m 0.97 / 20.5 / 3.3 m. The bounds leave ~2.5× margin and separate a carried axis
-// from the lidar_only failure (several metres).
+// Measured on this sequence (docs/experiments/worlds-and-degeneracy.md): degenerate directions (all
+// along the axis) in 12 / 14 / 15 of 29 registered scans (singer_lio / imu_input / lidar_gyro; the
+// corner behind the start constrains the axis in the others); whitened information along the axis,
+// median of the flagged scans, prior vs lidar: 8.7e3 vs 522 (Singer-LIO), 533 vs 162
+// (baseline), 9.2 vs 207 (lidar_gyro: no accelerometer, only the GP prior holds the axis); ATE
+// 0.018 / 0.28 / 0.10 m, drift per 100 m 0.97 / 20.5 / 3.3 m. The bounds leave ~2.5× margin and
+// separate a carried axis from the lidar_only failure (several metres).
 TEST(DegenerateWorlds, CorridorAxisIsDetectedAndCarriedByThePriorAndTheImu) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput, LioMethod::kLidarGyro}) {
     sim::SimulatedSource source(Walk(sim::WorldKind::kCorridor));
@@ -92,7 +92,7 @@ TEST(DegenerateWorlds, CorridorAxisIsDetectedAndCarriedByThePriorAndTheImu) {
 }
 
 // lidar_only (measured: 15 of 28 registered scans degenerate, ATE 8.9 m with the remapping, 0.53 m
-// without it: README "Degeneracy" explains the difference).
+// without it: docs/experiments/worlds-and-degeneracy.md explains the difference).
 TEST(DegenerateWorlds, LidarOnlyReportsTheCorridorScansDegenerate) {
   sim::SimulatedSource source(Walk(sim::WorldKind::kCorridor));
   const lioapp::RunSummary run = lioapp::RunOdometry(source, Config(LioMethod::kLidarOnly));

@@ -32,7 +32,7 @@ OdometryConfig Config(LioMethod method) {
 
 // Bound on the ATE: measured 0.032 m (Singer-LIO), 0.149 m (baseline), 0.295 m (lidar_gyro);
 // the bound separates a bridged gap from divergence (holding the last IMU sample across such a
-// gap gave 12–55 m in the fast regime, README "IMU dropout").
+// gap gave 12–55 m in the fast regime, docs/experiments/imu-dropout.md).
 TEST(ImuDropout, EveryMethodRunsThroughAOneSecondOutage) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput, LioMethod::kLidarGyro}) {
     sim::SimulatedSource source(SequenceWithOutage());

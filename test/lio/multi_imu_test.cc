@@ -35,7 +35,7 @@ OdometryConfig Config(LioMethod method) {
 
 // The gyro biases differ by 0.09 rad/s per axis between the IMUs (0.16 rad/s in norm): one bias
 // shared by both, or biases swapped, would leave errors of ≥ 0.08 rad/s; each IMU's own estimate
-// must be within 0.02 rad/s (measured: see the README, "Several IMUs").
+// must be within 0.02 rad/s (measured: see docs/experiments/several-imus.md).
 TEST(MultiImu, SingerLioRunsTwoImusAndEstimatesEachOnesBiases) {
   sim::SimulatedSource source(TwoImuSequence(3.0));
   const lioapp::RunSummary run = lioapp::RunOdometry(source, Config(LioMethod::kSingerLio));

@@ -2,7 +2,7 @@
 # online calibration (used by lio.Odometry.SimExtrinsicError): evaluation.txt reports the
 # starting error as given, and the final one — unchanged without calibration, with its σ and
 # 3σ coverage with it. Tiny size (1 s, 16 beams, every 8th firing): a check of the plumbing,
-# not of the accuracy (test/lio/extrinsic_calibration_test.cc, README "Online calibration").
+# not of the accuracy (test/lio/extrinsic_calibration_test.cc, docs/experiments/calibration.md).
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 file(READ ${SOURCE_DIR}/data/sim_lio.yaml shipped)

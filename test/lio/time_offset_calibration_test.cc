@@ -1,8 +1,8 @@
-// Online clock-offset calibration end to end (OdometryConfig::calibration, README "Online
-// calibration"): on a short simulated sequence whose IMU stamps are late or early by a known δ
-// (sim::ImuConfig::stamp_offset_s), Singer-LIO and lidar_gyro started from δ = 0 estimate every
-// IMU's δ to within a millisecond with a σ that shrinks and covers the error; with calibration
-// off nothing is estimated or reported.
+// Online clock-offset calibration end to end (OdometryConfig::calibration,
+// docs/experiments/calibration.md): on a short simulated sequence whose IMU stamps are late or
+// early by a known δ (sim::ImuConfig::stamp_offset_s), Singer-LIO and lidar_gyro started from δ = 0
+// estimate every IMU's δ to within a millisecond with a σ that shrinks and covers the error; with
+// calibration off nothing is estimated or reported.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,7 +16,7 @@
 namespace ctlio::lio {
 namespace {
 
-// Sequence 100 (not one of the README's reported indices 0–9), a reduced lidar.
+// Sequence 100 (not one of the reported indices 0–9 of docs/experiments), a reduced lidar.
 sim::SimConfig Sequence(double duration_s, double stamp_offset_s, const std::string& extra = "") {
   sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 100);
   c.duration_s = duration_s;
@@ -35,9 +35,9 @@ OdometryConfig Config(LioMethod method, bool estimate) {
 }
 
 // Checks every IMU's final δ against the truth: within `tolerance`, and σ shrunk to less than half
-// of the first estimate's. (Whether 3σ covers the error is measured over 20 s sequences in the
-// README: after 3 s on this reduced lidar the σ of the window is still optimistic, 0.1 ms against
-// errors of 0.65 ms with two IMUs.)
+// of the first estimate's. (Whether 3σ covers the error is measured over 20 s sequences in
+// docs/experiments/calibration.md: after 3 s on this reduced lidar the σ of the window is still
+// optimistic, 0.1 ms against errors of 0.65 ms with two IMUs.)
 void ExpectOffsetsFound(const lioapp::RunSummary& run, size_t imus, double tolerance) {
   ASSERT_EQ(run.failed, 0) << run.first_failure;
   const ScanResult* first = nullptr;
@@ -67,7 +67,7 @@ TEST(TimeOffsetCalibration, SingerLioFindsTheOffsetOfTwoImus) {
       Sequence(3.0, 0.020, "rate=400,xyz=0.3:0:0,rpy=0:0:90,stamp_offset=-0.012"));
   // With the observability check's default (it reports, nothing is held). With
   // calibration.hold_unobservable this 3 s run on the sparsest lidar ends 2.2 / 2.4 ms off (not
-  // yet investigated; README "Online calibration").
+  // yet investigated; docs/experiments/calibration.md).
   const lioapp::RunSummary run = lioapp::RunOdometry(source, Config(LioMethod::kSingerLio, true));
   ASSERT_FALSE(run.scans.empty());
   EXPECT_EQ(run.scans.back().calibration.observability.size(), 2u);  // δ_0, δ_1 assessed

@@ -57,7 +57,8 @@ struct PaperFit {
 // The default study (400 Hz, σ_acc 0.05, 10 Hz positions σ 0.01, 10 s; default seed and
 // validation sets), the expectations of SPEC §6:
 // - Q_k, trained on the 3000-trajectory input validation set (Cramér–Rao spread ±2%), within 20%
-//   of the paper's and within 5% of the calibration formula (RESULTS.md derives both formulas);
+//   of the paper's and within 5% of the calibration formula (docs/experiments/study-1d.md derives
+//   both formulas);
 // - σ², α from the first 25 validation trajectories (4000 accelerometer samples each pin them
 //   down: ±0.8% and ±0.3 expected): σ² within 3% of 1, α < 0.5 (WNOJ) or within 10% of 10;
 // - IMU as input with the TRAINED Q_k consistent at >= 80% of the times on the full

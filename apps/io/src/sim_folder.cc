@@ -297,7 +297,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
     if (!config_yaml.empty()) y << YAML::Key << "config" << YAML::Value << YAML::Load(config_yaml);
     y << YAML::EndMap;
     WriteTextFile((dir / "ctlio_sim.yaml").string(),
-                  "# ctlio simulator dataset, layout in the ctlio README (Dataset folders)\n" +
+                  "# ctlio simulator dataset, layout: docs/user-guide/datasets-and-formats.md\n" +
                       std::string(y.c_str()) + "\n");
   }
   const std::string scans_path = (dir / "scans.csv").string();

@@ -37,7 +37,7 @@ SlidingWindowOptions WindowOptions(const OdometryConfig& config) {
   o.solver.max_num_iterations = config.frontend.solver_iterations;
   // window.threads go to the window's own work (interpolations, lidar rows) on ParallelFor's
   // persistent helpers; Ceres' evaluation stays on one thread: its thread pool wakes its workers
-  // per loop, which cost more than they saved here (README "LIO latency").
+  // per loop, which cost more than they saved here (docs/experiments/latency.md).
   o.threads = config.solver_threads;
   o.solver.minimizer_progress_to_stdout = false;
   o.solver.logging_type = ceres::SILENT;
@@ -632,7 +632,8 @@ const PreparedScan& LioOdometry::PrepareScan(const LidarScan& scan, const SE3& T
   thread_local SweepSelection selection;
   // With the overlap the second core runs the previous scan's map insertion and the
   // marginalisation meanwhile (StartOverlappedStages): a second range-gate thread would only
-  // contend with them for the two cores (README "LIO latency": preprocessing 6.4 against 4.7 ms).
+  // contend with them for the two cores (docs/experiments/latency.md: preprocessing 6.4 against 4.7
+  // ms).
   frontend_.SelectSweep(scan.points, prepared.T_robot_lidar, &selection,
                         config_.overlap_stages ? 1 : config_.frontend.threads);
   prepared.points.resize(selection.indices.size());

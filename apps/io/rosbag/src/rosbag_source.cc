@@ -298,7 +298,7 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
   if (last_imu_ns != INT64_MIN && t - last_imu_ns > options.imu_gap_warning_ns) {
     const double gap = 1e-9 * double(t - last_imu_ns);
     // Opt-in error; by default the samples are handed on and the odometry bridges the hole
-    // (README, "IMU gaps").
+    // (docs/user-guide/bad-input.md).
     if (options.max_imu_gap_ns > 0 && t - last_imu_ns > options.max_imu_gap_ns) {
       throw std::runtime_error(Where(imu_topic, imu_messages) + "gap of " + std::to_string(gap) +
                                " s in the IMU (limit " +

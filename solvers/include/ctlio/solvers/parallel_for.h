@@ -6,9 +6,9 @@
 // chunks simply run one after the other on the calling thread, with that same answer.
 //
 // Why a persistent pool that spins: the solve hands work to the second core a few dozen times per
-// scan (every evaluation's interpolations and lidar rows, README "LIO latency"), each worth ~0.1
-// ms. Starting a thread per call costs tens of microseconds, and so does waking a sleeping one on
-// a virtual machine; a helper that keeps polling for a while after its last chunk picks the next
+// scan (every evaluation's interpolations and lidar rows, docs/experiments/latency.md), each worth
+// ~0.1 ms. Starting a thread per call costs tens of microseconds, and so does waking a sleeping one
+// on a virtual machine; a helper that keeps polling for a while after its last chunk picks the next
 // one up in about a microsecond. It polls for ~0.3 ms (parallel_for.cc), then sleeps.
 #pragma once
 

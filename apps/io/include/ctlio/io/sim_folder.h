@@ -1,4 +1,4 @@
-// ctlio's own simulator folder layout (documented in README.md, "Dataset folders"):
+// ctlio's own simulator folder layout (docs/user-guide/datasets-and-formats.md):
 //   ctlio_sim.yaml        format: ctlio_sim, version: 2, gravity, imu_from_lidar (T_body_lidar),
 //                         optional true_imu_from_lidar (the truth when imu_from_lidar is a
 //                         perturbed nominal one, sim/extrinsic_error.h),

@@ -1,6 +1,6 @@
-// Ray casting against the solid primitives the simulated worlds are built from (README,
-// "Simulator"): axis-aligned boxes, vertical cylinders, spheres, horizontal planes and one
-// bilinear height field, with a uniform 2-D grid over the finite primitives.
+// Ray casting against the solid primitives the simulated worlds are built from
+// (docs/user-guide/simulator.md): axis-aligned boxes, vertical cylinders, spheres, horizontal
+// planes and one bilinear height field, with a uniform 2-D grid over the finite primitives.
 //
 // Every intersection is analytic: slab test for boxes, circle/quadratic for cylinders and
 // spheres, and for the height field a 2-D DDA over its cells with the exact root of the quadratic

@@ -1,4 +1,4 @@
-// Motion guided along a world's path (README, "Simulator: motion in long worlds").
+// Motion guided along a world's path (docs/user-guide/simulator.md).
 //
 // A world gives a closed centreline at floor level: a polygon with rounded corners, resampled at
 // a uniform arc-length spacing Δ and used as the control points of a closed uniform cubic

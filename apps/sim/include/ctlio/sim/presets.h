@@ -1,4 +1,4 @@
-// Simulator presets: a recording shaped like a real dataset (README, "Simulator: presets").
+// Simulator presets: a recording shaped like a real dataset (docs/user-guide/simulator.md).
 //
 // `newer_college` (Newer College Dataset 2020, SPEC §6): a handheld Ouster OS1-64 (Gen1) with
 // its internal IMU, carried by a walking person through the park world.

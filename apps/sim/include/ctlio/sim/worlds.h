@@ -1,4 +1,4 @@
-// The simulated worlds (README, "Simulator: worlds"). Each is a pure function of
+// The simulated worlds (docs/user-guide/simulator.md). Each is a pure function of
 // WorldConfig::seed and the documented parameters below: the geometry (a Scene of solid
 // primitives) and a closed guide path at floor level that the motion follows (guided_motion.h).
 // Random draws use one mt19937_64 seeded by std::seed_seq{seed, kind} in a fixed order, and

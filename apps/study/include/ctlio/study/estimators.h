@@ -73,7 +73,7 @@ InputSchedule BuildInputSchedule(const Trajectory& traj);
 // A trajectory shrinks from thousands of stretches to one summary per position interval, which
 // makes the likelihood of a large validation set cheap in time and memory (the positions carry
 // little information about Q_k, so its maximum-likelihood fit needs ~1000 trajectories; see
-// RESULTS.md).
+// docs/experiments/study-1d.md).
 struct InputIntervalSummary {
   double dt = 0.0;
   double delta_p = 0.0;

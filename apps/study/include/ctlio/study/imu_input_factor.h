@@ -6,11 +6,11 @@
 //   x_b = A(T)·x_a + [Δp; Δv] + n,  n ~ N(0, Σ),  A(T) = [[1, T], [0, 1]],
 // with Σ propagated piece by piece: Σ ← A(δ)ΣA(δ)ᵀ + q·B(δ)B(δ)ᵀ, B(δ) = [δ²/2; δ].
 // One piece gives a rank-one Σ, so a factor needs at least two pieces (checked).
-// Calibration (derived in apps/study/RESULTS.md, SPEC §6): the held sample's error over a stretch
-// makes the exact velocity noise (σ_acc² + Qc·Δt/3)·Δt² on WNOJ data, so the one-parameter model
-// q·BBᵀ is exact in v for q = σ_acc² + Qc·Δt/3 (its p entries are off by O(Qc·Δt⁵), negligible);
-// on Singer data the hold errors are correlated and their long-run variance gives
-// q ≈ σ_acc² + Qc·Δt/12.
+// Calibration (derived in docs/experiments/study-1d.md, SPEC §6): the held sample's error over a
+// stretch makes the exact velocity noise (σ_acc² + Qc·Δt/3)·Δt² on WNOJ data, so the one-parameter
+// model q·BBᵀ is exact in v for q = σ_acc² + Qc·Δt/3 (its p entries are off by O(Qc·Δt⁵),
+// negligible); on Singer data the hold errors are correlated and their long-run variance gives q ≈
+// σ_acc² + Qc·Δt/12.
 #pragma once
 
 #include <ceres/sized_cost_function.h>

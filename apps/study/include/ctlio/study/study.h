@@ -24,13 +24,13 @@ struct StudyConfig {
   // of the same stream, then more). Its only measurements are the positions, which say little
   // about Q_k: the Cramér–Rao spread of the fitted Q_k is ±11% with 100 trajectories, ±3.6%
   // with 1000 and ±2% with 3000, and the input estimator's NEES at 1000 test trajectories
-  // leaves the χ² bounds at most times once Q_k is ~10% off (RESULTS.md). A deviation from
-  // SPEC §6's 100 validation trajectories, which cannot pin Q_k down. 0 = use the
+  // leaves the χ² bounds at most times once Q_k is ~10% off (docs/experiments/study-1d.md). A
+  // deviation from SPEC §6's 100 validation trajectories, which cannot pin Q_k down. 0 = use the
   // `validation_trajectories` only.
   int input_validation_trajectories = 3000;
   int test_trajectories = 1000;
   // The seed of the study's first run, kept on principle: it was fixed before any result was
-  // seen (RESULTS.md reports other seeds beside it).
+  // seen (docs/experiments/study-1d.md reports other seeds beside it).
   uint64_t seed = 20250301;
   // Worker threads; results do not depend on it (test trajectories are accumulated in fixed
   // chunks merged in index order, sums over trajectories are taken in index order).

@@ -4,8 +4,8 @@
 // robust loss applied inside the block. Still one residual per point (SPEC §4: points are not
 // summed before squaring); what is batched is Ceres' per-block machinery — the evaluation call,
 // the invalidation and validity check, the loss correction and the manifold product, ~2/3 of the
-// instructions of a per-point block's evaluation (README "LIO latency") — which runs once per
-// interval instead of once per keypoint.
+// instructions of a per-point block's evaluation (docs/experiments/latency.md) — which runs once
+// per interval instead of once per keypoint.
 //
 // Why the loss goes inside, and how: Ceres robustifies a residual BLOCK by ρ(‖r‖²), so a block
 // of N points with a Ceres loss would be one robust term, not N. The block therefore applies
@@ -41,13 +41,13 @@
 // so cost, gradient and Gauss–Newton Hessian are those of the N rows up to rounding. What it saves
 // is Ceres' serial per-row work, which grows with N: zeroing, filling and checking its dense
 // Jacobian and the JᵀJ of its normal equations (a Singer-LIO scan's solve, N ≈ 600: 0.81× the
-// instructions, README "LIO latency"). JᵀJ is formed here instead, per chunk of kChunkRows rows on
-// the row runner (the chunks' sums added in chunk order: the same values for any split). R is the
-// Cholesky factor with complete pivoting of the Jacobi-scaled JᵀJ (unit diagonal), rank-revealing:
-// it stops where the largest remaining Schur-complement pivot is at most kPivotThreshold, and the
-// rows left zero carry no information above rounding: ~W³/3 flops, 5–9 µs per evaluation at
-// W = 36, where an eigendecomposition (InformationSquareRoot's, for the marginal prior) takes
-// ~95 µs; Eigen's LDLT pivots on the original diagonal and is not rank-revealing.
+// instructions, docs/experiments/latency.md). JᵀJ is formed here instead, per chunk of kChunkRows
+// rows on the row runner (the chunks' sums added in chunk order: the same values for any split). R
+// is the Cholesky factor with complete pivoting of the Jacobi-scaled JᵀJ (unit diagonal),
+// rank-revealing: it stops where the largest remaining Schur-complement pivot is at most
+// kPivotThreshold, and the rows left zero carry no information above rounding: ~W³/3 flops, 5–9 µs
+// per evaluation at W = 36, where an eigendecomposition (InformationSquareRoot's, for the marginal
+// prior) takes ~95 µs; Eigen's LDLT pivots on the original diagonal and is not rank-revealing.
 // Evaluated without Jacobians the block returns r₀ = 0 and the whole cost in the last row: such an
 // evaluation serves the cost, and the W + 1 values mean something only together with their
 // Jacobians, which are not the derivative of the residuals — numeric differentiation does not

@@ -1,7 +1,7 @@
 // Observability of the online calibration states (calibration_options.h) from the measurements
 // alone, so that an unobservable clock offset or extrinsic axis is detected and held instead of
-// drifting (README "Online calibration", issue: "the slow regime leaves parts unobservable: detect
-// and report that").
+// drifting (docs/experiments/calibration.md, issue: "the slow regime leaves parts unobservable:
+// detect and report that").
 //
 // Why not the window's σ: the marginal priors, linearised once and never revisited, keep adding
 // information about a static state on every slide, so the window's σ shrinks even when no

@@ -36,15 +36,15 @@ struct CalibrationOptions {
   // every 4th firing, both calibrations from the wrong start, horizon 20), where ν per scan was
   // (slow / medium): δ 0.05 / 40, φ ≤ 8e-5 / ≥ 0.5, ρ ≤ 3e-7 / ≥ 1e-3 — one scan of 0.1 s with
   // its knots free says little about the lever arm even with rotation, so the kinds differ by
-  // orders of magnitude; each threshold sits between the two regimes' horizon values (README
-  // "Online calibration"). δ's threshold was 10 until two knots per sweep (knots_per_scan 2,
-  // accel_variance 0.16) gave slow/100–101 ν = 28–31 over the horizon with δ 19–25 ms off, where
-  // medium/100–103 give ≥ 820 (one knot: ~1 / ~800); 100 sits between both.
+  // orders of magnitude; each threshold sits between the two regimes' horizon values
+  // (docs/experiments/calibration.md). δ's threshold was 10 until two knots per sweep
+  // (knots_per_scan 2, accel_variance 0.16) gave slow/100–101 ν = 28–31 over the horizon with δ
+  // 19–25 ms off, where medium/100–103 give ≥ 820 (one knot: ~1 / ~800); 100 sits between both.
   int observability_horizon_scans = 20;
   double time_offset_observability_threshold = 100.0;
   double rotation_observability_threshold = 0.1;
   double translation_observability_threshold = 1e-3;
-  // Off by default: on the joint runs (README "Online calibration") holding cost ATE in every
+  // Off by default: on the joint runs (docs/experiments/calibration.md) holding cost ATE in every
   // regime (medium 0.71 vs 0.60 cm, fast 2.14 vs 1.57, slow 29.3 / 10.0 vs 6.9 / 3.5 cm, the
   // wrong start being held), so the check reports and the user decides.
   bool hold_unobservable = false;
@@ -61,7 +61,7 @@ struct CalibrationOptions {
   // ScanResult::revised_scans > 0 (results() then holds the replayed estimates of the earlier
   // scans; warmup_results() keeps the ones returned live). Costs one processing of the span at that
   // scan (a latency spike) and the memory of its raw scans. 0 = off (no data kept), the default: on
-  // the 10 reported sequences (README "Online calibration") 2 s brought the medium regime's ATE
+  // the 10 reported sequences (docs/experiments/calibration.md) 2 s brought the medium regime's ATE
   // from 1.8× to 1.3× the true values' and made the fast regime's worse (2.8 vs 2.1 cm), as on the
   // tuning sequences 100–103.
   double warmup_replay_s = 0.0;
@@ -77,7 +77,8 @@ struct CalibrationOptions {
   // them with the first scan after it. Why: even started near the truth, the start-up
   // (a sparse one-scan map, the motion's onset) moves the calibration states by several degrees
   // and centimetres, and the map built then stays in use; held, the span is processed as with
-  // known values. With one pass it holds the live estimates (worse: README "Online calibration").
+  // known values. With one pass it holds the live estimates (worse:
+  // docs/experiments/calibration.md).
   bool warmup_replay_hold = false;
   // The last pass runs with the calibration fixed at the values the pass before it ended with
   // (the live estimates with one pass): no calibration states, the estimator of known values,
@@ -86,8 +87,8 @@ struct CalibrationOptions {
   // with known values (~30 instead of ~70 ms on the tuning runs), and estimating after the span
   // does not buy ATE (frozen and held after a 4 s span: 1.07 / 1.12x and 1.07 / 1.09x the true
   // values', tuning sequences 100-109, medium / fast); but the final values are the span's (12 s:
-  // the lever arm within 1.00 cm, where held-then-estimated reaches 0.57 cm). README "A longer
-  // warm-up". Exclusive with warmup_replay_hold.
+  // the lever arm within 1.00 cm, where held-then-estimated reaches 0.57 cm).
+  // docs/experiments/calibration.md, "A longer warm-up". Exclusive with warmup_replay_hold.
   bool warmup_replay_freeze = false;
   // Set by the held pass of a warm-up replay, not read from YAML: C_mi stays held (as with
   // window.estimate_gravity false and no extrinsic estimated) although the extrinsic is

@@ -1,7 +1,7 @@
-// Degeneracy of a scan's lidar term (README "Degeneracy"): which directions of the scan's pose
-// the point-to-plane residuals do not constrain (a corridor's axis, the horizontal plane of an
-// open field), and how much the rest of the window (motion prior, IMU, marginal prior) knows
-// along them.
+// Degeneracy of a scan's lidar term (docs/experiments/worlds-and-degeneracy.md): which directions
+// of the scan's pose the point-to-plane residuals do not constrain (a corridor's axis, the
+// horizontal plane of an open field), and how much the rest of the window (motion prior, IMU,
+// marginal prior) knows along them.
 //
 // Lidar information. H = Σ JᵀJ of the scan's point-to-plane residuals (whitened by
 // point_noise_sigma, the robust loss applied as Ceres applies it: SlidingWindow::Linearize), on

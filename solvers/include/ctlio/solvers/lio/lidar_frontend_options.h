@@ -69,10 +69,11 @@ struct LidarFrontendOptions {
   // "interval": the keypoints of one knot interval as one block (ContinuousPointToPlaneBatch),
   // still one residual and one robust loss per keypoint, applied inside the block as Ceres
   // applies it to a one-point block: the same estimates up to rounding at a fraction of Ceres'
-  // per-block cost (README "LIO latency");
+  // per-block cost (docs/experiments/latency.md);
   // "square_root": that block handed to Ceres in square-root form, W + 1 = 37 rows with the same
   // cost, gradient and Gauss–Newton Hessian (ContinuousPointToPlaneBatch::Form::kSquareRoot):
-  // the same estimates up to rounding, without Ceres' serial per-row work (README "LIO latency").
+  // the same estimates up to rounding, without Ceres' serial per-row work
+  // (docs/experiments/latency.md).
   std::string residual_blocks = "square_root";
   // Stop re-associating when the knots' poses move less than this between rounds.
   double convergence_translation = 1e-3;  // m

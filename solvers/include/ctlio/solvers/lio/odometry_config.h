@@ -69,7 +69,7 @@ struct OdometryConfig {
   double gap_velocity_walk = 4.0;
   // Holes in the IMU up to this length [s] are still preintegrated, holding the last sample (a
   // few missing samples: the hold's error grows with the square of the hole); only longer holes
-  // switch to the gap mode above, where the hold diverges (README "IMU dropout").
+  // switch to the gap mode above, where the hold diverges (docs/experiments/imu-dropout.md).
   double gap_hold_max = 0.1;
   // The earlier behaviour, kept to measure against: preintegrate across the gap holding the last
   // sample (zero-order hold).
@@ -98,7 +98,7 @@ struct OdometryConfig {
   // window.knots_per_scan (the GP methods; the baseline's states stay one per scan): K knots per
   // sweep, at the sweep's end and at K − 1 equally spaced times inside it, so the trajectory
   // between knots spans 1/K of a sweep (with 0.1 s sweeps, the fast regime's 4–8 Hz motion is
-  // interpolated coarsely; README "Online calibration"). The lidar residuals, IMU measurements,
+  // interpolated coarsely; docs/experiments/calibration.md). The lidar residuals, IMU measurements,
   // motion prior and bias walk go to the interval that holds their time; after the scan the
   // window marginalises down to window_knots − 1 knots as before. 1 = the paper's knot per scan.
   int knots_per_scan = 1;
