@@ -30,6 +30,11 @@ struct RunOptions {
   double play_rate = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
+  // Called after every scan not failed that inserted points into the odometry's voxel map, with
+  // those points (LioOdometry::newest_map_points: map frame, deskewed by the live estimate) and
+  // T moving them into the frame of RunSummary::live_trajectory (identity unless a calibration
+  // warm-up replay re-based the map frame): a map output (map_accumulator.h) without a copy.
+  std::function<void(const lio::ScanResult&, const std::vector<Vec3>&, const SE3&)> map_points;
 };
 
 struct AteResult {
