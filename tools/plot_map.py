@@ -8,8 +8,10 @@ binary_little_endian/big_endian), the x y z fields. The picture is a height rast
 shows the highest map point above it, coloured by that height (the 1st-99th percentile range, so
 a few stray points do not wash out the colours), white where there is none; so roofs, tree
 crowns and walls stand out from the ground. Pixels are the map voxel (--voxel, default 0.2 m) or
-coarser, at most about 2000 pixels across. The trajectory (TUM: t x y z qx qy qz qw) is drawn on
-top in black over white, its start marked. Axes in metres, equal aspect.
+coarser, at most about 2000 pixels across; when the map is much larger than the trajectory (a
+lidar sees ~100 m around a short path) a second panel shows the square 20 m around the
+trajectory at the voxel size. The trajectory (TUM: t x y z qx qy qz qw) is drawn on top in red
+over white, its start marked. Axes in metres, equal aspect.
 Exit code 3 if matplotlib is missing (the caller reports that no picture was written).
 """
 import argparse
@@ -101,6 +103,41 @@ def read_tum(path):
     return np.array([[float(v) for v in r[1:4]] for r in rows if len(r) >= 8]).reshape(-1, 3)
 
 
+def height_raster(points, lo, hi, pixel):
+    """The highest z over every pixel of [lo, hi] (NaN where no point), its extent for imshow."""
+    shape = np.maximum(np.ceil((hi - lo) / pixel).astype(int), 1)  # (nx, ny)
+    raster = np.full((shape[1], shape[0]), -np.inf)
+    inside = np.all((points[:, :2] >= lo) & (points[:, :2] < lo + shape * pixel), axis=1)
+    p = points[inside]
+    if len(p):
+        ix = np.clip(((p[:, 0] - lo[0]) / pixel).astype(int), 0, shape[0] - 1)
+        iy = np.clip(((p[:, 1] - lo[1]) / pixel).astype(int), 0, shape[1] - 1)
+        np.maximum.at(raster, (iy, ix), p[:, 2])
+    raster[np.isinf(raster)] = np.nan
+    hi = lo + shape * pixel
+    return raster, (lo[0], hi[0], lo[1], hi[1])
+
+
+def draw(ax, points, path, lo, hi, pixel, z_range, title):
+    cmap = matplotlib.colormaps["viridis"].copy()
+    cmap.set_bad("white")
+    raster, extent = height_raster(points, lo, hi, pixel)
+    image = ax.imshow(raster, origin="lower", extent=extent, cmap=cmap, vmin=z_range[0],
+                      vmax=z_range[1], interpolation="nearest")
+    if len(path):
+        ax.plot(path[:, 0], path[:, 1], color="white", lw=3.0)
+        ax.plot(path[:, 0], path[:, 1], color="#d62728", lw=1.4, label="trajectory (lidar)")
+        ax.plot(path[0, 0], path[0, 1], "o", color="#d62728", mec="white", ms=7, label="start")
+        ax.legend(loc="upper right", fontsize=8)
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title, fontsize=10)
+    return image
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("map")
@@ -118,37 +155,30 @@ def main():
     both = np.vstack([points[:, :2], path[:, :2]])
     lo, hi = both.min(axis=0) - 1.0, both.max(axis=0) + 1.0
     pixel = max(args.voxel, float((hi - lo).max()) / 2000.0)
-    shape = np.maximum(np.ceil((hi - lo) / pixel).astype(int), 1)  # (nx, ny)
-    raster = np.full((shape[1], shape[0]), -np.inf)
-    if len(points):
-        ix = np.clip(((points[:, 0] - lo[0]) / pixel).astype(int), 0, shape[0] - 1)
-        iy = np.clip(((points[:, 1] - lo[1]) / pixel).astype(int), 0, shape[1] - 1)
-        np.maximum.at(raster, (iy, ix), points[:, 2])
-    raster[np.isinf(raster)] = np.nan
-    if len(points):
-        z_lo, z_hi = np.percentile(points[:, 2], [1, 99])
-    else:
-        z_lo, z_hi = 0.0, 1.0
-    width = 10.0
-    height = width * shape[1] / shape[0]
-    fig, ax = plt.subplots(figsize=(width + 1.5, min(max(height, 4.0), 14.0) + 1.0), dpi=int(
-        os.environ.get("CTLIO_PLOT_DPI", "150")))
-    cmap = matplotlib.colormaps["viridis"].copy()
-    cmap.set_bad("white")
-    image = ax.imshow(raster, origin="lower", extent=(lo[0], hi[0], lo[1], hi[1]), cmap=cmap,
-                      vmin=z_lo, vmax=max(z_hi, z_lo + 1e-3), interpolation="nearest")
-    fig.colorbar(image, ax=ax, shrink=0.8, label="height of the highest point [m]")
+    z_range = (np.percentile(points[:, 2], [1, 99]) if len(points) else np.array([0.0, 1.0]))
+    z_range[1] = max(z_range[1], z_range[0] + 1e-3)
+    # The surroundings of the trajectory at the voxel size too, when the whole map is much
+    # larger (a lidar sees ~100 m around a path of a few tens): a square 20 m beyond the path.
+    zoom = None
     if len(path):
-        ax.plot(path[:, 0], path[:, 1], color="white", lw=3.0)
-        ax.plot(path[:, 0], path[:, 1], color="#d62728", lw=1.4, label="trajectory (lidar)")
-        ax.plot(path[0, 0], path[0, 1], "o", color="#d62728", mec="white", ms=7, label="start")
-        ax.legend(loc="upper right", fontsize=8)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title("%s\n%d map points, %.2f m voxels, %.2f m pixels" % (
-        args.title or os.path.basename(args.map), len(points), args.voxel, pixel), fontsize=10)
-    fig.tight_layout()
+        centre = 0.5 * (path[:, :2].min(axis=0) + path[:, :2].max(axis=0))
+        half = 0.5 * float((path[:, :2].max(axis=0) - path[:, :2].min(axis=0)).max()) + 20.0
+        if 2.0 * half < 0.6 * float((hi - lo).max()):
+            zoom = (centre - half, centre + half)
+    panels = 2 if zoom else 1
+    dpi = int(os.environ.get("CTLIO_PLOT_DPI", "150"))
+    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
+    height = min(max(7.0 * aspect, 4.0), 12.0) + 1.0
+    fig, axes = plt.subplots(1, panels, figsize=(7.0 * panels + 1.5, height), dpi=dpi,
+                             layout="constrained")
+    axes = np.atleast_1d(axes)
+    image = draw(axes[0], points, path, lo, hi, pixel, z_range,
+                 "%d map points, %.2f m voxels, %.2f m pixels" % (len(points), args.voxel, pixel))
+    if zoom:
+        draw(axes[1], points, path, zoom[0], zoom[1], args.voxel, z_range,
+             "around the trajectory, %.2f m pixels" % args.voxel)
+    fig.colorbar(image, ax=list(axes), shrink=0.8, label="height of the highest point [m]")
+    fig.suptitle(args.title or os.path.basename(args.map), fontsize=11)
     fig.savefig(args.png)
     return 0
 
