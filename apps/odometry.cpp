@@ -141,7 +141,8 @@ DEFINE_string(save_map, "",
               "FILE.png (python3-matplotlib) coloured by height with the trajectory. A relative "
               "FILE goes into the output folder (--out, or --out/<method> with several methods); "
               "an absolute one is used as is, with several methods with _<method> inserted "
-              "before the extension");
+              "before the extension. With a calibration warm-up replay the map starts at the "
+              "replay, in the frame of trajectory.tum");
 DEFINE_double(map_voxel_size, 0.2, "--save_map: voxel size [m]; one point per occupied voxel");
 DEFINE_int64(map_max_points, 5000000,
              "--save_map: at most this many map points (memory ~24 B x 1.43 per point, doubled "
@@ -367,10 +368,14 @@ int main(int argc, char** argv) {
       std::optional<lioapp::MapAccumulator> map;
       if (!FLAGS_save_map.empty()) {
         map.emplace(FLAGS_map_voxel_size, static_cast<size_t>(FLAGS_map_max_points));
-        options.map_points = [&map, &m](const lio::ScanResult&, const std::vector<Vec3>& points,
-                                        const SE3& T) {
+        options.map_points = [&map, &m](const lio::ScanResult& r, const std::vector<Vec3>& points) {
+          if (r.revised_scans > 0) {
+            LOG(INFO) << m << ": the map starts over in the frame of the calibration warm-up "
+                      << "replay (" << map->size() << " points of the live warm-up dropped)";
+            map->Clear();
+          }
           const size_t dropped = map->dropped_points();
-          map->Add(points, T);
+          map->Add(points);
           if (dropped == 0 && map->dropped_points() > 0) {
             LOG(WARNING) << m << ": the map reached --map_max_points " << map->max_points()
                          << ": points in new voxels are dropped from here on";
@@ -479,15 +484,9 @@ int main(int argc, char** argv) {
       }
       if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
       if (map) {
-        // The map is in the frame of the live trajectory (a warm-up replay re-bases
-        // trajectory.tum): the picture draws that one.
-        std::string tum = out + "/trajectory.tum";
-        if (run.warmup_replayed_scans > 0) {
-          tum = out + "/trajectory_live.tum";
-          io::WriteTum(tum, run.live_trajectory);
-        }
-        lioapp::WriteMap(*map, lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1), tum,
-                         FLAGS_plot, FLAGS_plot ? PythonWithMatplotlib() : "", CTLIO_TOOLS_DIR,
+        lioapp::WriteMap(*map, lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1),
+                         out + "/trajectory.tum", FLAGS_plot,
+                         FLAGS_plot ? PythonWithMatplotlib() : "", CTLIO_TOOLS_DIR,
                          m + " on " + run.source, ev);
       }
       folders.push_back(out);

@@ -101,6 +101,11 @@ void MapAccumulator::Add(const std::vector<Vec3>& points, const SE3& T) {
   }
 }
 
+void MapAccumulator::Clear() {
+  std::fill(keys_.begin(), keys_.end(), kEmpty);
+  size_ = added_ = dropped_cap_ = dropped_range_ = 0;
+}
+
 std::vector<Vec3> MapAccumulator::Points() const {
   std::vector<Vec3> out;
   out.reserve(size_);

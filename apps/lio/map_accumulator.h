@@ -35,6 +35,8 @@ class MapAccumulator {
 
   // Merges T·p for every p of `points` (map frame → output frame).
   void Add(const std::vector<Vec3>& points, const SE3& T = SE3());
+  // Empties the map (the counts too); the table keeps its size, peak_bytes() its peak.
+  void Clear();
 
   // One point per occupied voxel (the centroid of its points), in table order.
   std::vector<Vec3> Points() const;

@@ -116,6 +116,18 @@ TEST(MapAccumulator, MaxPointsBoundsTheMapAndItsMemory) {
   EXPECT_FALSE(moved);  // no point is where `first` was any more
 }
 
+TEST(MapAccumulator, ClearStartsOver) {
+  MapAccumulator map(0.5);
+  map.Add({Vec3(0.1, 0.1, 0.1), Vec3(3, 3, 3)});
+  map.Clear();
+  EXPECT_EQ(map.size(), 0u);
+  EXPECT_TRUE(map.Points().empty());
+  map.Add({Vec3(0.3, 0.2, 0.1)});  // the old centroid of its voxel does not come back
+  ASSERT_EQ(map.size(), 1u);
+  EXPECT_LT((map.Points()[0] - Vec3(0.3, 0.2, 0.1)).norm(), 1e-6);
+  EXPECT_EQ(map.added_points(), 1u);
+}
+
 TEST(MapAccumulator, BadInput) {
   EXPECT_THROW(MapAccumulator{0.0}, std::invalid_argument);
   EXPECT_THROW(MapAccumulator{-0.2}, std::invalid_argument);

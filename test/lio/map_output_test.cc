@@ -43,6 +43,18 @@ double FractionNearSurface(const sim::Scene& scene, const std::vector<Vec3>& poi
   return double(near) / double(points.size());
 }
 
+// The map frame in the world: the true lidar pose of the estimated scan `k` (default: the
+// first) times its estimate's inverse. (The lidar's, not the robot's: with an extrinsic estimated
+// online the registration fixes the lidar pose, T_mr absorbs the extrinsic's error.)
+SE3 WorldFromMap(const lioapp::RunSummary& run, const sim::SimulatedSource& source, size_t k = 0) {
+  const auto truth = source.GroundTruth();
+  const io::StampedPose& scan = run.trajectory.at(k);
+  const auto at = std::find_if(truth->begin(), truth->end(),
+                               [&](const io::StampedPose& q) { return q.t_ns == scan.t_ns; });
+  EXPECT_NE(at, truth->end());
+  return at == truth->end() ? SE3() : at->pose * scan.pose.Inverse();
+}
+
 TEST(MapOutput, PointsLieOnTheSimulatedSurfaces) {
   // The street world (façades, cars, poles, trees) at walking pace, reduced lidar.
   sim::SimConfig c =
@@ -56,10 +68,10 @@ TEST(MapOutput, PointsLieOnTheSimulatedSurfaces) {
   lioapp::MapAccumulator map(0.2);
   size_t scans_mapped = 0;
   lioapp::RunOptions options;
-  options.map_points = [&](const ScanResult& r, const std::vector<Vec3>& points, const SE3& T) {
+  options.map_points = [&](const ScanResult& r, const std::vector<Vec3>& points) {
     EXPECT_NE(r.status, ScanStatus::kFailed);
     EXPECT_FALSE(points.empty());
-    map.Add(points, T);
+    map.Add(points);
     ++scans_mapped;
   };
   const lioapp::RunSummary run = lioapp::RunOdometry(source, config, options);
@@ -68,14 +80,7 @@ TEST(MapOutput, PointsLieOnTheSimulatedSurfaces) {
   EXPECT_EQ(scans_mapped, run.trajectory.size());  // every estimated scan, the first included
   EXPECT_GT(map.size(), 3000u);
 
-  // The map frame in the world: the first scan's true lidar pose times its estimate's inverse.
-  const auto truth = source.GroundTruth();
-  ASSERT_TRUE(truth);
-  const io::StampedPose& first = run.trajectory.front();
-  const auto at = std::find_if(truth->begin(), truth->end(),
-                               [&](const io::StampedPose& q) { return q.t_ns == first.t_ns; });
-  ASSERT_NE(at, truth->end());
-  const SE3 T_world_map = at->pose * first.pose.Inverse();
+  const SE3 T_world_map = WorldFromMap(run, source);
   const std::vector<Vec3> points = map.Points();
   const sim::Scene& scene = source.simulator().world().scene;
   // Within 0.1 m, half a voxel: the centroid of a voxel cut by a corner sits off its surfaces by
@@ -98,6 +103,49 @@ TEST(MapOutput, PointsLieOnTheSimulatedSurfaces) {
   for (size_t i = 0; i < points.size(); i += 97) {
     EXPECT_LT((back.points[i] - points[i]).norm(), 1e-4);
   }
+}
+
+TEST(MapOutput, StartsOverAtTheCalibrationWarmupReplay) {
+  // Both calibrations from a wrong start (3° / 10 cm extrinsic, 20 ms clock offset), replayed
+  // after 1 s: the warm-up's live points, placed with the wrong extrinsic, are not in the map;
+  // the replay's are, in the frame of the revised trajectory.
+  sim::SimulatedSource source(testing::WrongCalibrationSequence(sim::Regime::kMedium, 2.0, 0.020));
+  OdometryConfig config = testing::SimLioConfig();
+  config.calibration.estimate_time_offset = true;
+  config.calibration.estimate_extrinsic = true;
+  config.calibration.warmup_replay_s = 1.0;
+  config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
+  lioapp::MapAccumulator map(0.2), everything(0.2);
+  int restarts = 0;
+  lioapp::RunOptions options;
+  options.extrinsic_from_config = true;
+  options.map_points = [&](const ScanResult& r, const std::vector<Vec3>& points) {
+    if (r.revised_scans > 0) {
+      ++restarts;
+      map.Clear();
+    }
+    map.Add(points);
+    everything.Add(points);
+  };
+  const lioapp::RunSummary run = lioapp::RunOdometry(source, config, options);
+  ASSERT_EQ(run.failed, 0) << run.first_failure;
+  ASSERT_GT(run.warmup_replayed_scans, 0);
+  EXPECT_EQ(restarts, 1);
+  // Anchored at the newest scan: the map starts at the replay, whose first scans' poses it
+  // revised (anchored at the first, 70 % of the points are within 0.1 m; 100 % from the replay
+  // on).
+  const sim::Scene& scene = source.simulator().world().scene;
+  const SE3 T_world_map = WorldFromMap(run, source, run.trajectory.size() - 1);
+  const double on = FractionNearSurface(scene, map.Points(), T_world_map, 0.1);
+  // Without the restart the warm-up's live points, in the live frame with the wrong extrinsic,
+  // stay in the map.
+  const double kept = FractionNearSurface(scene, everything.Points(), T_world_map, 0.1);
+  std::printf(
+      "replayed map: %zu points, %.1f%% within 0.1 m of a surface; %.1f%% of %zu with "
+      "the warm-up kept\n",
+      map.size(), 100.0 * on, 100.0 * kept, everything.size());
+  EXPECT_GT(on, 0.95);
+  EXPECT_LT(kept, on - 0.05);
 }
 
 TEST(MapOutput, OneFilePerMethod) {
