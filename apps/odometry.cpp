@@ -145,9 +145,9 @@ DEFINE_string(save_map, "",
               "replay, in the frame of trajectory.tum");
 DEFINE_double(map_voxel_size, 0.2, "--save_map: voxel size [m]; one point per occupied voxel");
 DEFINE_int64(map_max_points, 5000000,
-             "--save_map: at most this many map points (memory ~24 B x 1.43 per point, doubled "
-             "while the table grows); once reached, points in new voxels are dropped with a "
-             "warning; 0 = no cap");
+             "--save_map: at most this many map points (the voxel table: 34-69 B per point, 1.5x "
+             "that while it doubles; the default's bound is 302 MB); once reached, points in new "
+             "voxels are dropped with a warning; 0 = no cap");
 DEFINE_string(sim_imu_dropout, "",
               "--format sim: IMU outages start:length[,start:length...] in seconds since the "
               "sequence start (samples inside are absent), e.g. 5:1");
