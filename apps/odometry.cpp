@@ -24,6 +24,8 @@
 // an error naming the path, exit 2); the odometry's input gates (lio/input_checks.h, config section
 // `input:`) are reported in scans.log, evaluation.txt and the summary, and --max_imu_gap_error
 // makes IMU gaps in the dataset files an error instead of a warning (docs/user-guide/bad-input.md).
+// --save_map FILE.pcd|.ply writes the registered, deskewed points as a voxel-downsampled map and
+// a top view FILE.png of it with the trajectory (apps/lio/map_accumulator.h, map_output.h).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
@@ -52,6 +54,8 @@
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
+#include "lio/map_accumulator.h"
+#include "lio/map_output.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
@@ -129,6 +133,21 @@ DEFINE_string(sim_extrinsic_error, "",
               "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
               "drawn per --sim_index when omitted; apps/sim extrinsic_error.h); the final "
               "extrinsic error is reported against the truth");
+DEFINE_string(save_map, "",
+              "Write the run's map to FILE.pcd or FILE.ply (binary, x y z float32): every scan's "
+              "preprocessed points as the odometry inserted them into its own map, i.e. in the "
+              "map frame and deskewed with that scan's live (causal) estimate, merged into "
+              "--map_voxel_size voxels (the centroid of each), written at the end; and a top view "
+              "FILE.png (python3-matplotlib) coloured by height with the trajectory. A relative "
+              "FILE goes into the output folder (--out, or --out/<method> with several methods); "
+              "an absolute one is used as is, with several methods with _<method> inserted "
+              "before the extension. With a calibration warm-up replay the map starts at the "
+              "replay, in the frame of trajectory.tum");
+DEFINE_double(map_voxel_size, 0.2, "--save_map: voxel size [m]; one point per occupied voxel");
+DEFINE_int64(map_max_points, 5000000,
+             "--save_map: at most this many map points (the voxel table: 34-69 B per point, 1.5x "
+             "that while it doubles; the default's bound is 302 MB); once reached, points in new "
+             "voxels are dropped with a warning; 0 = no cap");
 DEFINE_string(sim_imu_dropout, "",
               "--format sim: IMU outages start:length[,start:length...] in seconds since the "
               "sequence start (samples inside are absent), e.g. 5:1");
@@ -208,14 +227,20 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
 #define CTLIO_TOOLS_DIR "tools"
 #endif
 
-// Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
-bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& folders) {
+// --python, else the first of python3, /usr/bin/python3 with matplotlib; empty if none.
+std::string PythonWithMatplotlib() {
   std::string python = FLAGS_python;
   for (const char* p : {"python3", "/usr/bin/python3"}) {
     if (!python.empty()) break;
     const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
     if (std::system(probe.c_str()) == 0) python = p;
   }
+  return python;
+}
+
+// Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
+bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& folders) {
+  const std::string python = PythonWithMatplotlib();
   if (python.empty()) return false;
   std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
   for (const std::string& f : folders) cmd += " '" + f + "'";
@@ -300,6 +325,9 @@ int main(int argc, char** argv) {
     if (!(FLAGS_play_rate >= 0.0) || !std::isfinite(FLAGS_play_rate)) {
       throw std::runtime_error("--play_rate must be a finite number >= 0 (0 = back to back)");
     }
+    if (!FLAGS_save_map.empty()) {  // before the run, not after an hour of it
+      lioapp::CheckMapFlags(FLAGS_save_map, FLAGS_map_voxel_size, FLAGS_map_max_points);
+    }
     std::vector<lioapp::RunSummary> runs;
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
@@ -335,6 +363,23 @@ int main(int argc, char** argv) {
               r.status == lio::ScanStatus::kImuGap || r.status == lio::ScanStatus::kSuspect) {
             std::fprintf(stderr, "\n  %s at t = %.3f s: %s\n", lio::ScanStatusName(r.status),
                          1e-9 * double(r.t_ns), r.message.c_str());
+          }
+        };
+      }
+      std::optional<lioapp::MapAccumulator> map;
+      if (!FLAGS_save_map.empty()) {
+        map.emplace(FLAGS_map_voxel_size, static_cast<size_t>(FLAGS_map_max_points));
+        options.map_points = [&map, &m](const lio::ScanResult& r, const std::vector<Vec3>& points) {
+          if (r.revised_scans > 0) {
+            LOG(INFO) << m << ": the map starts over in the frame of the calibration warm-up "
+                      << "replay (" << map->size() << " points of the live warm-up dropped)";
+            map->Clear();
+          }
+          const size_t dropped = map->dropped_points();
+          map->Add(points);
+          if (dropped == 0 && map->dropped_points() > 0) {
+            LOG(WARNING) << m << ": the map reached --map_max_points " << map->max_points()
+                         << ": points in new voxels are dropped from here on";
           }
         };
       }
@@ -439,6 +484,12 @@ int main(int argc, char** argv) {
         }
       }
       if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+      if (map) {
+        lioapp::WriteMap(*map, lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1),
+                         out + "/trajectory.tum", FLAGS_plot,
+                         FLAGS_plot ? PythonWithMatplotlib() : "", CTLIO_TOOLS_DIR,
+                         m + " on " + run.source, ev);
+      }
       folders.push_back(out);
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       io::CloseChecked(ev, ev_path);

@@ -333,6 +333,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     if (r.status != lio::ScanStatus::kFailed) {
       run.live_trajectory.push_back({r.t_ns, live_from_replay * LidarPose(r, T_imu_lidar)});
+      const std::vector<Vec3>* inserted = odometry->newest_map_points();
+      if (options.map_points && inserted != nullptr) {
+        options.map_points(r, *inserted);
+      }
     }
     if (r.revised_scans > 0) {
       // The calibration warm-up replay replaced the earlier scans' results: tally those instead

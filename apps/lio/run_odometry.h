@@ -30,6 +30,13 @@ struct RunOptions {
   double play_rate = 0.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
+  // Called after every scan not failed that inserted points into the odometry's voxel map, with
+  // those points (LioOdometry::newest_map_points: map frame, deskewed by the live estimate), for
+  // a map output (map_accumulator.h) without a copy. A scan that replayed the calibration
+  // warm-up (ScanResult::revised_scans > 0) hands over the replay's points, in the replayed map
+  // frame of RunSummary::trajectory: a map starts over there (the warm-up's live points were
+  // placed with the calibration the replay revised, a 3° extrinsic error puts them metres off).
+  std::function<void(const lio::ScanResult&, const std::vector<Vec3>&)> map_points;
 };
 
 struct AteResult {

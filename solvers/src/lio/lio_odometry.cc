@@ -278,6 +278,7 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
     have_origin_ = true;
   }
   ScanResult result;
+  map_points_inserted_ = false;
   LidarScan trimmed;
   std::string dropped_note;  // added to the message once the scan is processed
   const LidarScan& scan = DropPointsOutsideInterval(input, &trimmed, &dropped_note);
@@ -371,7 +372,9 @@ void LioOdometry::Initialise(const PreparedScan& scan, ScanResult* result) {
     return;
   }
   estimator_->Initialise(scan, C_mi_, &window_);
-  frontend_.UpdateMap(Positions(scan.points), Vec3::Zero());
+  map_points_ = Positions(scan.points);
+  frontend_.UpdateMap(map_points_, Vec3::Zero());
+  map_points_inserted_ = true;
   initialised_ = true;
   estimator_->Report(result);
   if (result->status == ScanStatus::kOk) result->status = ScanStatus::kInitialising;
@@ -400,6 +403,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   if (EstimatePlausible(result)) {
     estimator_->MapPoints(scan, &map_points_);
     map_position_ = estimator_->NewestPose().translation();
+    map_points_inserted_ = true;
     if (config_.overlap_stages) {
       // Inserted on a second thread from now on: in real time, while the robot waits for the
       // next sweep; back to back, beside the rest of this scan and the next one's preprocessing.

@@ -78,6 +78,13 @@ class LioOdometry {
   // grid times (multiples of the period in absolute ns) in (previous, newest state) and the newest
   // state's time, whose pose is the scan's T_mr. Empty before the second state.
   std::vector<std::pair<int64_t, SE3>> SampleNewestInterval(double rate_hz) const;
+  // What the newest scan inserted into the voxel map: its preprocessed points in the map frame,
+  // each moved by the estimated motion at its time (Estimator::MapPoints; the first scan's as
+  // prepared, at the origin), the same vector the map was fed, not a copy. nullptr when the
+  // newest scan inserted nothing (failed, implausible jump). Valid until the next AddScan.
+  const std::vector<Vec3>* newest_map_points() const {
+    return active().map_points_inserted_ ? &active().map_points_ : nullptr;
+  }
 
  private:
   const LioOdometry& active() const { return replay_ != nullptr ? *replay_ : *this; }
@@ -192,6 +199,7 @@ class LioOdometry {
   // scan thread, or with config.overlap_stages on the second one (StartMapInsertion).
   std::vector<Vec3> map_points_;
   Vec3 map_position_ = Vec3::Zero();
+  bool map_points_inserted_ = false;  // by the newest scan (newest_map_points)
   // config.overlap_stages: whether this scan's marginalisation is done (overlapped with its
   // preprocessing).
   bool slid_ = false;
