@@ -42,6 +42,7 @@
 #include <thread>
 #include <tuple>
 
+#include "common/command_line.h"
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/sim/extrinsic_error.h"
@@ -69,8 +70,9 @@ DEFINE_int32(first_sequence, 0, "Index of the first sequence");
 DEFINE_double(duration, 20.0, "Sequence length [s] (the paper: 20)");
 DEFINE_int32(beams, 128, "Lidar beams (the paper: 128)");
 DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resolution)");
-DEFINE_double(lidar_rate, 10.0,
-              "Lidar revolutions (= scans, = knots) per second (the firings per revolution stay)");
+DEFINE_double(
+    lidar_rate, 10.0,
+    "Lidar revolutions (= scans, = knots) per second [Hz] (the firings per revolution stay)");
 DEFINE_int32(threads, 0, "Parallel runs (0 = number of cores)");
 DEFINE_bool(body_centric, false, "Simulate the paper's body-centric accelerometer model");
 DEFINE_double(failure_ate, 1.0, "A run whose ATE exceeds this [m] counts as a failure");
@@ -468,9 +470,16 @@ void WriteObservability(const std::string& out, const std::vector<Job>& jobs) {
   if (any) io::WriteTextFile(out + "/observability.csv", csv.str());
 }
 
+constexpr char kUsage[] =
+    "ctlio_experiment: the paper's Table II: simulates regimes x sequences and runs every\n"
+    "method on each, in parallel; writes OUT/table.md, results.csv and table2.svg.\n"
+    "\n"
+    "  ctlio_experiment --out /tmp/t2 --sequences 3 --duration 5 --beams 32 --firing_decimation 4\n"
+    "  ctlio_experiment --out /tmp/table2                    # the full experiment (hours)\n"
+    "  ctlio_experiment --merge /tmp/a,/tmp/b --out /tmp/ab  # pool split jobs";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Table II: Singer-LIO vs the IMU-as-input baseline in simulation");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {

@@ -39,6 +39,7 @@
 #include <optional>
 #include <sstream>
 
+#include "common/command_line.h"
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
@@ -67,7 +68,9 @@ DEFINE_string(time_field, "", "Per-point time field (default: detected; 'none' =
 DEFINE_string(time_unit, "", "Override the time field's unit: s | ms | us | ns");
 DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | absolute");
 DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
-DEFINE_double(imu_accel_scale, 1.0, "rosbag: accelerometer scale (9.80665 for IMUs reporting g)");
+DEFINE_double(
+    imu_accel_scale, 1.0,
+    "rosbag: factor from the accelerometer's unit to m/s² (9.80665 for IMUs reporting g)");
 DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_double(trajectory_rate, 0.0,
@@ -76,7 +79,9 @@ DEFINE_double(trajectory_rate, 0.0,
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
-DEFINE_string(config, "", "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml)");
+DEFINE_string(config, "",
+              "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml); empty: the built-in "
+              "defaults");
 DEFINE_string(out, "", "Output folder (created); with several methods one subfolder per method");
 DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all; negative is an error)");
 DEFINE_double(max_imu_gap_error, 0.0,
@@ -99,9 +104,10 @@ DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking 
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
-DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
+DEFINE_int32(sim_firing_decimation, 1,
+             "--format sim: keep every n-th firing (1 = full resolution)");
 DEFINE_double(sim_lidar_rate, 10.0,
-              "--format sim: lidar revolutions (= scans, = knots) per second; the firings per "
+              "--format sim: lidar revolutions (= scans, = knots) per second [Hz]; the firings per "
               "revolution stay, so a faster rate spreads them over a shorter sweep");
 DEFINE_int32(sim_beams, 128, "--format sim: lidar beams");
 DEFINE_string(sim_imus, "",
@@ -276,9 +282,17 @@ void WriteExtrinsicEvaluation(const lioapp::RunSummary& run, std::ostream& ev) {
 
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_odometry: lidar-inertial odometry (Singer-LIO and the IMU-as-input baseline) on a\n"
+    "dataset folder, a ROS 1 bag or the built-in simulator; writes the trajectory, a per-scan log\n"
+    "and, with ground truth, the ATE.\n"
+    "\n"
+    "  ctlio_odometry --dataset DIR|FILE.bag --config data/newer_college_lio.yaml --out /tmp/run\n"
+    "  ctlio_odometry --format sim --sim_regime medium --sim_duration 5 \\\n"
+    "      --config data/sim_lio.yaml --method singer_lio,imu_input --out /tmp/sim_run";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Lidar-inertial odometry (Singer-LIO and the IMU-as-input baseline)");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {
