@@ -89,8 +89,7 @@ TEST(ProgressReporter, TerminalRewritesOneLineAndEndsItBeforeAnEvent) {
   progress.Event("  failed at t = 0.200 s: diverged");
   progress.Update(3, 3, "scan 3");
   progress.Finish();
-  EXPECT_EQ(os.str(),
-            "\rscan 1   \rscan 2   \n  failed at t = 0.200 s: diverged\n\rscan 3   \n");
+  EXPECT_EQ(os.str(), "\rscan 1   \rscan 2   \n  failed at t = 0.200 s: diverged\n\rscan 3   \n");
 }
 
 TEST(ConfigOrigin, SaysWhenTheBuiltInDefaultsApply) {
@@ -104,8 +103,8 @@ TEST(ConfigOrigin, NamesTheFilesAConfigExtends) {
   std::ofstream(dir + "/a.yaml") << "base: " << dir << "/b.yaml\n";  // absolute works as well
   std::ofstream(dir + "/plain.yaml") << "point_noise_sigma: 0.02\n";
   EXPECT_EQ(DescribeConfig(dir + "/plain.yaml"), dir + "/plain.yaml");
-  EXPECT_EQ(DescribeConfig(dir + "/a.yaml"), dir + "/a.yaml (extends " + dir +
-                                                 "/b.yaml, which extends " + dir + "/c.yaml)");
+  EXPECT_EQ(DescribeConfig(dir + "/a.yaml"),
+            dir + "/a.yaml (extends " + dir + "/b.yaml, which extends " + dir + "/c.yaml)");
   // The repository's calibration config extends the simulator config.
   EXPECT_EQ(DescribeConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml"),
             std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml (extends " +
