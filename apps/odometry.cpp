@@ -24,6 +24,9 @@
 // an error naming the path, exit 2); the odometry's input gates (lio/input_checks.h, config section
 // `input:`) are reported in scans.log, evaluation.txt and the summary, and --max_imu_gap_error
 // makes IMU gaps in the dataset files an error instead of a warning (README, "IMU gaps").
+// It says first which config it runs (or the built-in defaults), shows its progress on stderr
+// (apps/lio/progress.h) and ends with the summary and the list of the files written (every writer
+// registers its file with `files.Add(path, description)`, apps/lio/output_files.h).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
