@@ -351,6 +351,7 @@ int main(int argc, char** argv) {
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       options.play_rate = FLAGS_play_rate;
       lioapp::ProgressReporter progress(std::cerr, lioapp::ProgressReporter::IsTerminal(2));
+      progress.SetEventLimit(20, "scans.log has every scan's status and message");
       if (FLAGS_progress) {
         options.progress = [&](size_t done, size_t total, const lio::ScanResult& r) {
           char line[160];

@@ -39,14 +39,26 @@ void ProgressReporter::Update(size_t done, size_t total, const std::string& text
 }
 
 void ProgressReporter::Event(const std::string& text) {
+  if (events_++ >= max_events_) return;
   EndOpenLine();
   os_ << text << '\n' << std::flush;
 }
 
+void ProgressReporter::SetEventLimit(size_t max_events, const std::string& where) {
+  max_events_ = max_events;
+  events_where_ = where;
+}
+
 void ProgressReporter::Finish() {
   EndOpenLine();
-  if (!pending_.empty()) os_ << pending_ << '\n' << std::flush;
+  if (!pending_.empty()) os_ << pending_ << '\n';
   pending_.clear();
+  if (events_ > max_events_) {
+    os_ << "  (" << events_ - max_events_ << " more such lines not shown"
+        << (events_where_.empty() ? "" : "; " + events_where_) << ")\n";
+  }
+  events_ = 0;
+  os_ << std::flush;
 }
 
 void ProgressReporter::EndOpenLine() {

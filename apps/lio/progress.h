@@ -25,9 +25,15 @@ class ProgressReporter {
   void Update(size_t done, size_t total, const std::string& text);
 
   // A line of its own (a warning about one item): ends a status line left open on a terminal.
+  // After `max_events` (SetEventLimit) the events are only counted.
   void Event(const std::string& text);
 
-  // The last status, if not shown yet (non-terminal), and the end of the line (terminal).
+  // Shows at most `max_events` events; Finish then says how many more there were and `where` to
+  // find them (a run with a degenerate scan in every other scan would otherwise print hundreds).
+  void SetEventLimit(size_t max_events, const std::string& where);
+
+  // The last status, if not shown yet (non-terminal), the end of the line (terminal), and how many
+  // events were not shown.
   void Finish();
 
  private:
@@ -41,6 +47,9 @@ class ProgressReporter {
   int last_tenth_ = 0;
   bool line_open_ = false;  // terminal: a '\r' line without its newline yet
   std::string pending_;     // non-terminal: the newest status not yet written
+  size_t max_events_ = static_cast<size_t>(-1);
+  size_t events_ = 0;
+  std::string events_where_;
 };
 
 }  // namespace ctlio::lioapp

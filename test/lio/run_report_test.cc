@@ -92,6 +92,19 @@ TEST(ProgressReporter, TerminalRewritesOneLineAndEndsItBeforeAnEvent) {
   EXPECT_EQ(os.str(), "\rscan 1   \rscan 2   \n  failed at t = 0.200 s: diverged\n\rscan 3   \n");
 }
 
+TEST(ProgressReporter, ShowsAtMostTheEventLimitAndCountsTheRest) {
+  double now = 0.0;
+  std::ostringstream os;
+  ProgressReporter progress(os, false, 5.0, [&] { return now; });
+  progress.SetEventLimit(2, "scans.log has every scan");
+  for (int i = 0; i < 5; ++i) progress.Event("degenerate " + std::to_string(i));
+  progress.Update(1, 1, "scan 1/1");
+  progress.Finish();
+  EXPECT_EQ(Lines(os.str()), (std::vector<std::string>{
+                                 "degenerate 0", "degenerate 1", "scan 1/1",
+                                 "  (3 more such lines not shown; scans.log has every scan)"}));
+}
+
 TEST(ConfigOrigin, SaysWhenTheBuiltInDefaultsApply) {
   EXPECT_EQ(DescribeConfig(""), "built-in defaults (no --config)");
 }
