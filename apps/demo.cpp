@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "common/command_line.h"
 #include "ctlio/manifolds/pose_manifold.h"
 
 DEFINE_int32(points, 200, "Number of simulated point correspondences");
@@ -31,9 +32,15 @@ class PointError final : public ceres::SizedCostFunction<3, 7> {
 };
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_demo: fits a pose on the SE(3) manifold to noisy point correspondences with Ceres and\n"
+    "prints the error before and after (a first check that the build works).\n"
+    "\n"
+    "  ctlio_demo                          # 200 correspondences, 1 cm noise\n"
+    "  ctlio_demo --points=50 --noise=0.05";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Fits a pose to noisy point correspondences on the SE(3) manifold.");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   CHECK_GT(FLAGS_points, 2) << "--points must be at least 3";

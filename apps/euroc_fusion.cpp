@@ -45,16 +45,17 @@
 #include <string>
 #include <vector>
 
+#include "common/command_line.h"
 #include "ctlio/euroc/fusion.h"
 
 DEFINE_string(data_dir, "",
               "EuRoC sequence folder with imu0_data.csv and "
               "groundtruth_vicon2gt_20hz.csv (default: <shared data>/euroc_v1_01_easy)");
-DEFINE_double(position_sigma, 0.05, "std of the Gaussian noise added to the positions (m)");
+DEFINE_double(position_sigma, 0.05, "std of the Gaussian noise added to the positions [m]");
 DEFINE_int32(seed, 5, "seed of the position noise");
-DEFINE_double(fit_start, 20.0, "start of the fitting chunk (s after the first position)");
-DEFINE_double(fit_seconds, 20.0, "length of the fitting chunk in the first half (s)");
-DEFINE_double(eval_seconds, 0.0, "length of the evaluation segment (0 = whole second half)");
+DEFINE_double(fit_start, 20.0, "start of the fitting chunk [s after the first position]");
+DEFINE_double(fit_seconds, 20.0, "length of the fitting chunk in the first half [s]");
+DEFINE_double(eval_seconds, 0.0, "length of the evaluation segment [s] (0 = whole second half)");
 DEFINE_string(accel_model, "specific_force",
               "accelerometer model of the fit and of rows (2), (3): specific_force (exact, with "
               "w x v) or body_centric (the paper's, no w x v)");
@@ -69,11 +70,11 @@ DEFINE_bool(cauchy_warm_start, true,
 DEFINE_bool(verbose, false, "print the solver progress");
 DEFINE_int32(max_iterations, 200, "Levenberg-Marquardt iterations per solve");
 DEFINE_bool(skip_fit, false, "use the hyperparameters given by the flags below");
-DEFINE_double(qc_pos, 1.0, "positions-only Qc when --skip_fit");
-DEFINE_double(qc_trans, 1000.0, "WNOJ/Singer translational Qc when --skip_fit");
-DEFINE_double(qc_rot, 1000.0, "WNOJ/Singer rotational Qc when --skip_fit");
-DEFINE_double(alpha_trans, 10.0, "Singer translational alpha when --skip_fit");
-DEFINE_double(alpha_rot, 10.0, "Singer rotational alpha when --skip_fit");
+DEFINE_double(qc_pos, 1.0, "positions-only Qc [m²/s⁵] when --skip_fit");
+DEFINE_double(qc_trans, 1000.0, "WNOJ/Singer translational Qc [m²/s⁵] when --skip_fit");
+DEFINE_double(qc_rot, 1000.0, "WNOJ/Singer rotational Qc [rad²/s⁵] when --skip_fit");
+DEFINE_double(alpha_trans, 10.0, "Singer translational alpha [1/s] when --skip_fit");
+DEFINE_double(alpha_rot, 10.0, "Singer rotational alpha [1/s] when --skip_fit");
 
 namespace ctlio::euroc {
 namespace {
@@ -257,11 +258,16 @@ int Run() {
 }  // namespace
 }  // namespace ctlio::euroc
 
+constexpr char kUsage[] =
+    "ctlio_euroc_fusion: IMU as input vs as measurement (WNOJ, Singer) vs positions only,\n"
+    "on a EuRoC MAV sequence with noisy 10 Hz ground-truth positions; prints the position and\n"
+    "rotation RMSE and the NEES of every method.\n"
+    "\n"
+    "  ctlio_euroc_fusion                          # <shared data>/euroc_v1_01_easy\n"
+    "  ctlio_euroc_fusion --data_dir=DIR --markdown=results.md";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage(
-      "ctlio_euroc_fusion [--data_dir=DIR]: IMU as input vs as measurement vs positions only on "
-      "a EuRoC sequence");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   // A fit or evaluation window without positions (10 Hz) has nothing to fit or evaluate.
   if (!(FLAGS_fit_seconds >= 1.0) || !(FLAGS_eval_seconds == 0.0 || FLAGS_eval_seconds >= 1.0)) {

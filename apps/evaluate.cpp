@@ -16,6 +16,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "common/command_line.h"
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/trajectory_io.h"
@@ -68,9 +69,15 @@ std::string FindPython() {
 
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_evaluate: ATE and RPE of an estimated trajectory against a reference (TUM or\n"
+    "KITTI files); with --output_dir also metrics.txt, metrics.json, errors.csv and plots.\n"
+    "\n"
+    "  ctlio_evaluate --estimate=est.tum --reference=gt.tum [--align=se3|sim3|none]\n"
+    "  ctlio_evaluate --estimate=est.tum --reference=gt.tum --rpe_distances=10,50 --output_dir=ev";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Absolute and relative trajectory errors (TUM/KITTI)");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   if (FLAGS_estimate.empty() || FLAGS_reference.empty()) {

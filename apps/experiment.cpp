@@ -34,6 +34,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -42,6 +43,7 @@
 #include <thread>
 #include <tuple>
 
+#include "common/command_line.h"
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/sim/extrinsic_error.h"
@@ -50,7 +52,9 @@
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
+#include "lio/config_origin.h"
 #include "lio/experiment_results.h"
+#include "lio/output_files.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(out, "", "Output folder (required)");
@@ -69,8 +73,9 @@ DEFINE_int32(first_sequence, 0, "Index of the first sequence");
 DEFINE_double(duration, 20.0, "Sequence length [s] (the paper: 20)");
 DEFINE_int32(beams, 128, "Lidar beams (the paper: 128)");
 DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resolution)");
-DEFINE_double(lidar_rate, 10.0,
-              "Lidar revolutions (= scans, = knots) per second (the firings per revolution stay)");
+DEFINE_double(
+    lidar_rate, 10.0,
+    "Lidar revolutions (= scans, = knots) per second [Hz] (the firings per revolution stay)");
 DEFINE_int32(threads, 0, "Parallel runs (0 = number of cores)");
 DEFINE_bool(body_centric, false, "Simulate the paper's body-centric accelerometer model");
 DEFINE_double(failure_ate, 1.0, "A run whose ATE exceeds this [m] counts as a failure");
@@ -104,6 +109,8 @@ DEFINE_string(merge, "",
 namespace {
 
 using namespace ctlio;
+
+lioapp::OutputFiles written;  // every file the run writes, listed at its end
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -223,7 +230,9 @@ void WriteExtrinsicErrors(const std::string& out, const std::vector<Job>& jobs) 
     csv << ',' << run.warmup_replayed_scans << ',' << (run.live_ate ? run.live_ate->rmse : NAN)
         << "\n";
   }
-  if (any) io::WriteTextFile(out + "/extrinsic.csv", csv.str());
+  if (!any) return;
+  io::WriteTextFile(out + "/extrinsic.csv", csv.str());
+  written.Add(out + "/extrinsic.csv", "extrinsic error [deg, cm] and sigmas per run");
 }
 
 // The settings that must be equal for runs to be pooled, one "key value" per line.
@@ -288,10 +297,14 @@ void WriteTable(const std::string& out, const std::string& settings,
   md << "\n"
      << provenance << " A failure is a run with a failed scan or an ATE above "
      << kv.at("failure_ate_m") << " m. Scenario outage_Ls: no IMU samples for L s centred on the "
-     << "sequence midpoint.\n";
+     << "sequence midpoint. Scans degenerate: status `degenerate`, the lidar did not fix the pose "
+     << "(results.csv degenerate_scans); degen_dir: the lidar term had a degenerate direction, "
+     << "whatever the status (with an IMU the scan stays `ok`; degenerate_direction_scans).\n";
   io::WriteTextFile(out + "/table.md", md.str());
+  written.Add(out + "/table.md", "the table above (Markdown)");
   std::printf("%s", md.str().c_str());
   lioapp::WritePooledCsv(out + "/pooled.csv", cells);
+  written.Add(out + "/pooled.csv", "the table's numbers, one line per cell (CSV)");
   std::vector<std::tuple<std::string, std::string, double>> bars;
   std::vector<std::string> regimes, methods;
   for (const auto& c : cells) {
@@ -303,6 +316,7 @@ void WriteTable(const std::string& out, const std::string& settings,
       methods.push_back(c.method);
   }
   WriteBarSvg(out + "/table2.svg", bars, regimes, methods);
+  written.Add(out + "/table2.svg", "bar plot of the RMSE ATE per regime and method [cm]");
 }
 
 // OUT/nees.csv (one line per run: mean NEES of the pose, its translation and rotation, the
@@ -354,6 +368,7 @@ void WriteNees(const std::string& out, const std::vector<Job>& jobs) {
     ++it->second.runs;
   }
   io::CloseChecked(f, out + "/nees.csv");
+  written.Add(out + "/nees.csv", "mean NEES and bias errors per run");
   std::ostringstream md;
   md << "| regime | method | scenario | runs | scans | NEES pose (6) | translation (3) | rotation "
         "(3) |\n|---|---|---|---|---|---|---|---|\n";
@@ -363,6 +378,7 @@ void WriteNees(const std::string& out, const std::vector<Job>& jobs) {
        << c.translation / n << " | " << c.rotation / n << " |\n";
   }
   io::WriteTextFile(out + "/nees.md", md.str());
+  written.Add(out + "/nees.md", "the consistency table (Markdown)");
   std::printf("\nConsistency (mean NEES over all scans of the runs):\n%s", md.str().c_str());
 }
 
@@ -391,7 +407,9 @@ void Merge() {
   if (rows.empty()) throw std::runtime_error("--merge: no runs in " + FLAGS_merge);
   std::filesystem::create_directories(FLAGS_out);
   io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
+  written.Add(FLAGS_out + "/settings.txt", "the settings runs must share to be merged");
   lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
+  written.Add(FLAGS_out + "/results.csv", "one line per run: ATE [m], scan counts, ms (CSV)");
   WriteTable(FLAGS_out, settings, rows,
              "Merged from " + std::to_string(dirs.size()) + " jobs (" + FLAGS_merge + ").");
 }
@@ -440,6 +458,8 @@ void WriteCalibration(const std::string& out, const std::vector<Job>& jobs) {
     }
   }
   io::CloseChecked(f, out + "/calibration.csv");
+  written.Add(out + "/calibration.csv",
+              "clock offset estimate, sigma and error [s] per run and IMU");
 }
 
 // OUT/observability.csv (one line per run and calibration coordinate, with the observability
@@ -465,18 +485,28 @@ void WriteObservability(const std::string& out, const std::vector<Job>& jobs) {
       csv << ',' << (i < fraction.size() ? fraction[i] : NAN) << "\n";
     }
   }
-  if (any) io::WriteTextFile(out + "/observability.csv", csv.str());
+  if (!any) return;
+  io::WriteTextFile(out + "/observability.csv", csv.str());
+  written.Add(out + "/observability.csv", "observability of every calibration coordinate per run");
 }
 
+constexpr char kUsage[] =
+    "ctlio_experiment: the paper's Table II: simulates regimes x sequences and runs every\n"
+    "method on each, in parallel; writes OUT/table.md, results.csv and table2.svg.\n"
+    "\n"
+    "  ctlio_experiment --out /tmp/t2 --sequences 3 --duration 5 --beams 32 --firing_decimation 4\n"
+    "  ctlio_experiment --out /tmp/table2                    # the full experiment (hours)\n"
+    "  ctlio_experiment --merge /tmp/a,/tmp/b --out /tmp/ab  # pool split jobs";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Table II: Singer-LIO vs the IMU-as-input baseline in simulation");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     if (!FLAGS_merge.empty()) {
       Merge();
+      written.Print(std::cout);
       return 0;
     }
     std::filesystem::create_directories(FLAGS_out);
@@ -487,6 +517,9 @@ int main(int argc, char** argv) {
             ? std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml"
             : std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml";
     const lio::OdometryConfig base = lio::LoadOdometryConfig(config_path);
+    std::printf("config: %s%s\n", lioapp::DescribeConfig(config_path).c_str(),
+                FLAGS_config.empty() ? " (the default; --config to choose another)" : "");
+    std::fflush(stdout);
     const sim::Preset preset = sim::ParsePreset(FLAGS_sim_preset);
     sim::SimOverrides given;  // the settings every sequence shares (regime: per job)
     if (auto w = Given("world", FLAGS_world)) given.world = sim::ParseWorld(*w);
@@ -624,7 +657,9 @@ int main(int argc, char** argv) {
     const std::string settings =
         SettingsText(config_path, sim::PresetName(preset), world_name, shared);
     io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
+    written.Add(FLAGS_out + "/settings.txt", "the settings runs must share to be merged");
     lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);
+    written.Add(FLAGS_out + "/results.csv", "one line per run: ATE [m], scan counts, ms (CSV)");
     if (FLAGS_pose_covariance) WriteNees(FLAGS_out, jobs);
     if (FLAGS_estimate_time_offset || base.calibration.estimate_time_offset) {
       WriteCalibration(FLAGS_out, jobs);
@@ -636,6 +671,9 @@ int main(int argc, char** argv) {
     std::ostringstream provenance;
     provenance << "Wall time " << el << " s on " << threads << " threads.";
     WriteTable(FLAGS_out, settings, rows, provenance.str());
+    std::printf("\n");
+    std::fflush(stdout);
+    written.Print(std::cout);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ctlio_experiment: %s\n", e.what());

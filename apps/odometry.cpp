@@ -26,6 +26,9 @@
 // makes IMU gaps in the dataset files an error instead of a warning (docs/user-guide/bad-input.md).
 // --save_map FILE.pcd|.ply writes the registered, deskewed points as a voxel-downsampled map and
 // a top view FILE.png of it with the trajectory (apps/lio/map_accumulator.h, map_output.h).
+// It says first which config it runs (or the built-in defaults), shows its progress on stderr
+// (apps/lio/progress.h) and ends with the summary and the list of the files written (every writer
+// registers its file with `files.Add(path, description)`, apps/lio/output_files.h).
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
@@ -41,6 +44,7 @@
 #include <optional>
 #include <sstream>
 
+#include "common/command_line.h"
 #include "common/preset_flags.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
@@ -54,8 +58,11 @@
 #include "ctlio/sim/presets.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
+#include "lio/config_origin.h"
 #include "lio/map_accumulator.h"
 #include "lio/map_output.h"
+#include "lio/output_files.h"
+#include "lio/progress.h"
 #include "lio/run_odometry.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
@@ -71,7 +78,9 @@ DEFINE_string(time_field, "", "Per-point time field (default: detected; 'none' =
 DEFINE_string(time_unit, "", "Override the time field's unit: s | ms | us | ns");
 DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | absolute");
 DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
-DEFINE_double(imu_accel_scale, 1.0, "rosbag: accelerometer scale (9.80665 for IMUs reporting g)");
+DEFINE_double(
+    imu_accel_scale, 1.0,
+    "rosbag: factor from the accelerometer's unit to m/s² (9.80665 for IMUs reporting g)");
 DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_double(trajectory_rate, 0.0,
@@ -80,7 +89,9 @@ DEFINE_double(trajectory_rate, 0.0,
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
-DEFINE_string(config, "", "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml)");
+DEFINE_string(config, "",
+              "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml); empty: the built-in "
+              "defaults");
 DEFINE_string(out, "", "Output folder (created); with several methods one subfolder per method");
 DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all; negative is an error)");
 DEFINE_double(max_imu_gap_error, 0.0,
@@ -103,9 +114,10 @@ DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking 
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
-DEFINE_int32(sim_firing_decimation, 1, "--format sim: keep every n-th firing");
+DEFINE_int32(sim_firing_decimation, 1,
+             "--format sim: keep every n-th firing (1 = full resolution)");
 DEFINE_double(sim_lidar_rate, 10.0,
-              "--format sim: lidar revolutions (= scans, = knots) per second; the firings per "
+              "--format sim: lidar revolutions (= scans, = knots) per second [Hz]; the firings per "
               "revolution stay, so a faster rate spreads them over a shorter sweep");
 DEFINE_int32(sim_beams, 128, "--format sim: lidar beams");
 DEFINE_string(sim_imus, "",
@@ -301,9 +313,17 @@ void WriteExtrinsicEvaluation(const lioapp::RunSummary& run, std::ostream& ev) {
 
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_odometry: lidar-inertial odometry (Singer-LIO and the IMU-as-input baseline) on a\n"
+    "dataset folder, a ROS 1 bag or the built-in simulator; writes the trajectory, a per-scan log\n"
+    "and, with ground truth, the ATE.\n"
+    "\n"
+    "  ctlio_odometry --dataset DIR|FILE.bag --config data/newer_college_lio.yaml --out /tmp/run\n"
+    "  ctlio_odometry --format sim --sim_regime medium --sim_duration 5 \\\n"
+    "      --config data/sim_lio.yaml --method singer_lio,imu_input --out /tmp/sim_run";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Lidar-inertial odometry (Singer-LIO and the IMU-as-input baseline)");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {
@@ -318,6 +338,8 @@ int main(int argc, char** argv) {
       config_extrinsic = root["extrinsic"].IsDefined();
       base = lio::OdometryConfigFromYaml(root, FLAGS_config);
     }
+    std::printf("config: %s\n", lioapp::DescribeConfig(FLAGS_config).c_str());
+    std::fflush(stdout);
     // The readers' IMU gap limit (input.max_imu_gap_error): the flag wins over the config.
     const bool gap_flag = !gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default;
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
@@ -331,6 +353,8 @@ int main(int argc, char** argv) {
     std::vector<lioapp::RunSummary> runs;
     std::vector<std::string> folders;
     std::vector<std::vector<io::StampedPose>> truths;
+    lioapp::OutputFiles files;  // every file written, listed at the end
+    const auto run_start = std::filesystem::file_time_type::clock::now();
     for (const std::string& m : methods) {
       lio::OdometryConfig config = base.ForMethod(lio::ParseLioMethod(m));
       if (gap_flag) config.input.max_imu_gap_error = FLAGS_max_imu_gap_error;
@@ -355,14 +379,20 @@ int main(int argc, char** argv) {
       options.extrinsic_from_config = config_extrinsic;
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       options.play_rate = FLAGS_play_rate;
+      lioapp::ProgressReporter progress(std::cerr, lioapp::ProgressReporter::IsTerminal(2));
+      progress.SetEventLimit(20, "scans.log has every scan's status and message");
       if (FLAGS_progress) {
-        options.progress = [&m](size_t done, size_t total, const lio::ScanResult& r) {
-          std::fprintf(stderr, "\r[%s] scan %zu/%zu  %-12s %5d assoc  %6.1f ms   ", m.c_str(), done,
-                       total, lio::ScanStatusName(r.status), r.associations, r.milliseconds);
+        options.progress = [&](size_t done, size_t total, const lio::ScanResult& r) {
+          char line[160];
+          std::snprintf(line, sizeof(line), "[%s] scan %zu/%zu  %-12s %5d associations  %6.1f ms",
+                        m.c_str(), done, total, lio::ScanStatusName(r.status), r.associations,
+                        r.milliseconds);
+          progress.Update(done, total, line);
           if (r.status == lio::ScanStatus::kFailed || r.status == lio::ScanStatus::kDegenerate ||
               r.status == lio::ScanStatus::kImuGap || r.status == lio::ScanStatus::kSuspect) {
-            std::fprintf(stderr, "\n  %s at t = %.3f s: %s\n", lio::ScanStatusName(r.status),
-                         1e-9 * double(r.t_ns), r.message.c_str());
+            std::snprintf(line, sizeof(line), "  %s at t = %.3f s: ", lio::ScanStatusName(r.status),
+                          1e-9 * double(r.t_ns));
+            progress.Event(line + r.message);
           }
         };
       }
@@ -387,10 +417,17 @@ int main(int argc, char** argv) {
       // The calibration.yaml values, also summarised in evaluation.txt.
       const auto recommended =
           lioapp::RecommendCalibration(run, FLAGS_calibration_keep_unobservable);
-      if (FLAGS_progress) std::fprintf(stderr, "\n");
+      if (FLAGS_progress) progress.Finish();
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
-      if (!run.dense.empty()) io::WriteTum(out + "/trajectory_dense.tum", run.dense);
+      files.Add(out + "/trajectory.tum",
+                "T_world_lidar at every scan end (TUM: t x y z qx qy qz qw)");
+      if (!run.dense.empty()) {
+        io::WriteTum(out + "/trajectory_dense.tum", run.dense);
+        files.Add(out + "/trajectory_dense.tum",
+                  "the estimate at --trajectory_rate between scans (TUM)");
+      }
       lioapp::WriteScanLog(out + "/scans.log", run);
+      files.Add(out + "/scans.log", "one line per scan: status, residuals, times [ms], degeneracy");
       const std::string ev_path = out + "/evaluation.txt";
       std::ofstream ev = io::OpenForWriting(ev_path);
       ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
@@ -443,20 +480,25 @@ int main(int argc, char** argv) {
         }
         ev << std::setprecision(6) << "\n";
         io::WriteTum(out + "/ground_truth.tum", *source->GroundTruth());
+        files.Add(out + "/ground_truth.tum", "the source's ground truth (TUM)");
         lioapp::WritePoseErrors(out + "/pose_errors.csv", run.trajectory, *source->GroundTruth(),
                                 run.ate->alignment);
+        files.Add(out + "/pose_errors.csv", "per-pose position [m] and rotation [deg] error");
         truths.push_back(*source->GroundTruth());
       } else {
         truths.emplace_back();
       }
       if (config.calibration.any()) {
         lioapp::WriteCalibrationLog(out + "/calibration.csv", run);
+        files.Add(out + "/calibration.csv", "online calibration estimates and sigmas per scan");
         // After a warm-up replay, the estimates it replaced, which the plot draws beside it.
         if (!run.warmup_live_scans.empty()) {
           lioapp::WriteCalibrationLog(out + "/calibration_live.csv", run, &run.warmup_live_scans);
+          files.Add(out + "/calibration_live.csv", "the estimates the warm-up replay replaced");
         }
         if (recommended) {
           lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run, *recommended);
+          files.Add(out + "/calibration.yaml", "the calibration to use in the next --config");
         }
         if (recommended && !recommended->kept_at_start.empty()) {
           std::string names;
@@ -483,16 +525,26 @@ int main(int argc, char** argv) {
           // (The extrinsic's lines follow here.)
         }
       }
-      if (FLAGS_write_bag) io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+      if (FLAGS_write_bag) {
+        io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+        files.Add(out + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)");
+      }
       if (map) {
-        lioapp::WriteMap(*map, lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1),
-                         out + "/trajectory.tum", FLAGS_plot,
+        const std::string map_path = lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1);
+        lioapp::WriteMap(*map, map_path, out + "/trajectory.tum", FLAGS_plot,
                          FLAGS_plot ? PythonWithMatplotlib() : "", CTLIO_TOOLS_DIR,
                          m + " on " + run.source, ev);
+        files.Add(map_path, "the registered, deskewed map (--save_map), map frame, x y z float32");
+        const std::string map_png = lioapp::MapPicturePath(map_path);
+        std::error_code no_png;
+        if (FLAGS_plot && std::filesystem::exists(map_png, no_png)) {
+          files.Add(map_png, "plot: top view of the map with the trajectory");
+        }
       }
       folders.push_back(out);
       if (!run.first_failure.empty()) ev << "first_failure \"" << run.first_failure << "\"\n";
       io::CloseChecked(ev, ev_path);
+      files.Add(ev_path, "counts, times [ms], ATE [m] of the run (one `key value` per line)");
       runs.push_back(std::move(run));
     }
     if (FLAGS_plot && !PlotWithMatplotlib(FLAGS_out, folders)) {
@@ -506,8 +558,26 @@ int main(int argc, char** argv) {
                                 truths[k], runs[k].ate->alignment, title);
       }
     }
-    std::printf("\n%-12s %8s %8s %8s %6s %6s %9s %9s %9s %9s %9s\n", "method", "ATE[m]", "mean[m]",
-                "max[m]", "failed", "degen", "med[ms]", "p95[ms]", "cpu_med", "cpu_p95", "peakMB");
+    // The plots this run made (not those an earlier run left in the folder).
+    const auto made = [&](const std::string& path) {
+      std::error_code error;
+      return std::filesystem::exists(path, error) &&
+             std::filesystem::last_write_time(path, error) >= run_start;
+    };
+    for (const std::string& f : folders) {
+      for (const auto& [name, what] :
+           {std::pair<const char*, const char*>{"odometry.png",
+                                                "plot: trajectory, errors, scan times"},
+            {"calibration.png", "plot: calibration estimates, ±3σ"},
+            {"trajectory_topview.svg", "plot: top view (no matplotlib)"}}) {
+        if (made(f + "/" + name)) files.Add(f + "/" + name, what);
+      }
+    }
+    if (folders.size() > 1 && made(FLAGS_out + "/comparison.png")) {
+      files.Add(FLAGS_out + "/comparison.png", "plot: the methods side by side");
+    }
+    std::printf("\n%-12s %8s %8s %8s %13s %6s %6s %10s %9s\n", "method", "ATE[m]", "mean[m]",
+                "max[m]", "drift[m/100m]", "scans", "failed", "degenerate", "degen_dir");
     for (const auto& r : runs) {
       if (r.ate) {
         std::printf("%-12s %8.4f %8.4f %8.4f", r.method.c_str(), r.ate->rmse, r.ate->mean,
@@ -515,8 +585,31 @@ int main(int argc, char** argv) {
       } else {
         std::printf("%-12s %8s %8s %8s", r.method.c_str(), "-", "-", "-");
       }
-      std::printf(" %6d %6d %9.1f %9.1f %9.1f %9.1f %9.1f\n", r.failed, r.degenerate, r.median_ms,
-                  r.p95_ms, r.median_cpu_ms, r.p95_cpu_ms, r.peak_rss_kb / 1024.0);
+      char drift[32] = "-";
+      if (r.drift_per_100m) std::snprintf(drift, sizeof(drift), "%.3f", *r.drift_per_100m);
+      std::printf(" %13s %6zu %6d %10d %9d\n", drift, r.scans.size(), r.failed, r.degenerate,
+                  r.degenerate_direction_scans);
+    }
+    std::printf(
+        "  degenerate: scans with status `degenerate` (evaluation.txt degenerate_scans):\n"
+        "    the lidar did not fix the pose (too few associations, or lidar_only along a\n"
+        "    degenerate direction)\n"
+        "  degen_dir: scans whose lidar term had a degenerate direction, whatever their\n"
+        "    status (with an IMU they stay `ok`; evaluation.txt degenerate_direction_scans,\n"
+        "    scans.log degen_dirs)\n");
+    std::printf("\nTime per scan [ms] (the first scan, which starts the map, excluded):\n");
+    std::printf("%-12s %8s %8s %8s %8s %10s %10s %9s %8s %8s %9s\n", "method", "wall_med",
+                "wall_p95", "cpu_med", "cpu_p95", "preprocess", "associate", "solve", "map",
+                "marginal", "peak[MB]");
+    for (const auto& r : runs) {
+      std::printf("%-12s %8.1f %8.1f %8.1f %8.1f %10.1f %10.1f %9.1f %8.1f %8.1f %9.1f\n",
+                  r.method.c_str(), r.median_ms, r.p95_ms, r.median_cpu_ms, r.p95_cpu_ms,
+                  r.median_preprocess_ms, r.median_associate_ms, r.median_solve_ms, r.median_map_ms,
+                  r.median_marginalize_ms, r.peak_rss_kb / 1024.0);
+    }
+    std::printf(
+        "  (preprocess ... marginal: medians of the wall-time split; peak: resident memory)\n");
+    for (const auto& r : runs) {
       if (r.imu_rejected + r.points_dropped + r.scans_skipped + r.constant_imu_scans > 0) {
         std::printf(
             "  %-10s input: %d IMU samples rejected, %d points dropped, %d scans skipped, %d scans "
@@ -524,16 +617,11 @@ int main(int argc, char** argv) {
             r.method.c_str(), r.imu_rejected, r.points_dropped, r.scans_skipped,
             r.constant_imu_scans, r.first_input_warning.c_str());
       }
-      std::printf(
-          "  %-10s wall-time split, median ms: preprocess %.1f  associate %.1f  solve %.1f"
-          "  map %.1f  marginalise %.1f\n",
-          r.method.c_str(), r.median_preprocess_ms, r.median_associate_ms, r.median_solve_ms,
-          r.median_map_ms, r.median_marginalize_ms);
-      std::printf("  %-10s drift per 100 m: %s m; scans with degenerate directions: %d of %zu\n",
-                  r.method.c_str(),
-                  r.drift_per_100m ? std::to_string(*r.drift_per_100m).c_str() : "-",
-                  r.degenerate_direction_scans, r.scans.size());
     }
+    std::printf("\n");
+    std::ostringstream listing;
+    files.Print(listing);
+    std::printf("%s", listing.str().c_str());
     int bad = 0;
     for (const auto& r : runs) bad += r.failure ? 1 : 0;
     return bad ? 1 : 0;

@@ -23,6 +23,7 @@
 #include <random>
 #include <sstream>
 
+#include "common/command_line.h"
 #include "common/preset_flags.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
@@ -41,17 +42,20 @@ DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | v
 DEFINE_string(world, "box", "World: box | street | corridor | park | indoor");
 DEFINE_uint64(world_seed, ctlio::sim::kExperimentSeed, "Seed of the world's geometry");
 DEFINE_string(topview, "", "Also write a top view of the world and its path (SVG) to this file");
-DEFINE_double(range_noise_per_m, 0.0, "Range noise growing with range: σ = 0.02 m + k·r");
-DEFINE_double(lidar_dropout, 0.0, "Probability that a lidar return is lost at random");
-DEFINE_double(max_incidence_deg, 90.0, "Returns at a larger incidence angle are lost");
-DEFINE_double(reflect_range, 0.0, "Weak echoes: a return needs r ≤ this·√cos(incidence); 0 = off");
+DEFINE_double(range_noise_per_m, 0.0,
+              "Range noise growing with range: σ = 0.02 m + k·r, k [m/m]; 0 = constant 2 cm");
+DEFINE_double(lidar_dropout, 0.0, "Probability that a lidar return is lost at random [0, 1]");
+DEFINE_double(max_incidence_deg, 90.0, "Returns at a larger incidence angle [deg] are lost");
+DEFINE_double(reflect_range, 0.0,
+              "Weak echoes: a return needs r ≤ this·√cos(incidence) [m]; 0 = off");
 DEFINE_double(beam_elevation_error_deg, 0.0, "σ of fixed per-beam elevation errors [deg]");
 DEFINE_double(beam_azimuth_error_deg, 0.0, "σ of fixed per-beam azimuth errors [deg]");
-DEFINE_string(accel_scale, "0,0,0", "Accelerometer scale-factor errors s (x,y,z): (1+s)·f");
-DEFINE_string(gyro_scale, "0,0,0", "Gyro scale-factor errors s (x,y,z): (1+s)·ω");
+DEFINE_string(accel_scale, "0,0,0",
+              "Accelerometer scale-factor errors s (x,y,z; dimensionless): (1+s)·f");
+DEFINE_string(gyro_scale, "0,0,0", "Gyro scale-factor errors s (x,y,z; dimensionless): (1+s)·ω");
 DEFINE_double(accel_limit, 0.0, "Accelerometer saturation per axis [m/s²]; 0 = none");
 DEFINE_double(gyro_limit, 0.0, "Gyro saturation per axis [rad/s]; 0 = none");
-DEFINE_string(imu_dropout, "", "IMU outages start:length in seconds, e.g. 5.0:0.5,12:2");
+DEFINE_string(imu_dropout, "", "IMU outages start:length [s], e.g. 5.0:0.5,12:2");
 DEFINE_string(imus, "",
               "Further IMUs (IMU 1, 2, ...), ';'-separated key=value lists: rate, xyz, rpy, "
               "offset, accel_noise, gyro_noise, accel_bias, gyro_bias, outage (apps/sim "
@@ -60,7 +64,7 @@ DEFINE_double(imu_stamp_offset, 0.0,
               "IMU 0's sample of the motion at t is stamped t - this [s] (a clock offset for the "
               "odometry's online calibration; recorded as true_time_offset_s in ctlio_sim.yaml; "
               "other IMUs: stamp_offset= in --imus)");
-DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second (Poisson); 0 = none");
+DEFINE_double(imu_outage_rate, 0.0, "Random IMU outages per second [1/s] (Poisson); 0 = none");
 DEFINE_double(imu_outage_min, 0.1, "Shortest random IMU outage [s]");
 DEFINE_double(imu_outage_max, 1.0, "Longest random IMU outage [s]");
 DEFINE_int32(index, 0, "Sequence index within the regime (the experiment uses 0..19)");
@@ -114,9 +118,16 @@ ctlio::Vec3 ParseVec3(const std::string& flag, const std::string& text) {
 
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_simulate: writes one sequence of the lidar-inertial simulator as a dataset folder\n"
+    "(ctlio's layout or Newer College's) or as a ROS 1 bag, with ground truth.\n"
+    "\n"
+    "  ctlio_simulate --regime=fast --index=3 --output=/tmp/fast_03 [--layout=newer_college]\n"
+    "  ctlio_simulate --world=street --regime=vehicle --output=/tmp/street --topview=street.svg\n"
+    "  ctlio_simulate --preset=newer_college --layout=rosbag --output=/tmp/nc_00.bag";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("Write a simulated lidar-inertial dataset folder");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   if (FLAGS_output.empty()) {

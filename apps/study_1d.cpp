@@ -15,14 +15,15 @@
 #include <iostream>
 #include <sstream>
 
+#include "common/command_line.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/study/study.h"
 
-DEFINE_double(duration, 10.0, "trajectory length (s)");
-DEFINE_double(accel_rate, 400.0, "accelerometer rate (Hz)");
-DEFINE_double(sigma_acc, 0.05, "accelerometer noise (m/s^2)");
-DEFINE_double(position_rate, 10.0, "position measurement rate (Hz)");
-DEFINE_double(sigma_pos, 0.01, "position noise (m)");
+DEFINE_double(duration, 10.0, "trajectory length [s]");
+DEFINE_double(accel_rate, 400.0, "accelerometer rate [Hz]");
+DEFINE_double(sigma_acc, 0.05, "accelerometer noise σ [m/s²]");
+DEFINE_double(position_rate, 10.0, "position measurement rate [Hz]");
+DEFINE_double(sigma_pos, 0.01, "position noise σ [m]");
 DEFINE_int32(validation, 100, "validation trajectories per dataset");
 DEFINE_int32(input_validation, 3000,
              "validation trajectories of the IMU-as-input (Q_k) likelihood: the first --validation "
@@ -44,11 +45,11 @@ DEFINE_string(only, "", "run only the scenario with this name (default, 100hz, d
 DEFINE_bool(main_study, true, "run the main study (default sensors); false: extras only");
 DEFINE_bool(extras, true, "also run 100 Hz/sigma 0.01, IMU dropout and two asynchronous IMUs");
 DEFINE_int32(extra_test, 1000, "test trajectories per dataset in the extra scenarios");
-DEFINE_double(dropout_start, 4.0, "extra scenario: accelerometer dropout start (s)");
-DEFINE_double(dropout_length, 1.0, "extra scenario: accelerometer dropout length (s)");
-DEFINE_double(async_rate_a, 200.0, "extra scenario: first accelerometer rate (Hz), offset 0");
-DEFINE_double(async_rate_b, 150.0, "extra scenario: second accelerometer rate (Hz)");
-DEFINE_double(async_offset_b, 0.0021, "extra scenario: second accelerometer first sample (s)");
+DEFINE_double(dropout_start, 4.0, "extra scenario: accelerometer dropout start [s]");
+DEFINE_double(dropout_length, 1.0, "extra scenario: accelerometer dropout length [s]");
+DEFINE_double(async_rate_a, 200.0, "extra scenario: first accelerometer rate [Hz], offset 0");
+DEFINE_double(async_rate_b, 150.0, "extra scenario: second accelerometer rate [Hz]");
+DEFINE_double(async_offset_b, 0.0021, "extra scenario: second accelerometer first sample [s]");
 
 namespace {
 
@@ -113,9 +114,16 @@ void PrintSummary(const std::string& scenario, const DatasetResult& r) {
 
 }  // namespace
 
+constexpr char kUsage[] =
+    "ctlio_study_1d: the paper's 1D study (Figs. 3-7), IMU as an input versus a measurement\n"
+    "of the state, and three extensions (100 Hz IMU, accelerometer dropout, two asynchronous\n"
+    "accelerometers).\n"
+    "\n"
+    "  ctlio_study_1d --output_dir=study_1d_out    # main study + extras, CSV/JSON + PNG plots\n"
+    "  ctlio_study_1d --extras=false --plot=false  # the timed main study only";
+
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage("1D study: IMU as an input versus a measurement of the state");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   try {
     std::filesystem::create_directories(FLAGS_output_dir);
     StudyConfig base;

@@ -170,8 +170,8 @@ std::vector<PooledCell> PoolRows(const std::vector<RunRow>& rows) {
 std::string PooledTableMarkdown(const std::vector<PooledCell>& cells) {
   std::ostringstream md;
   md << "| regime | method | scenario | runs | RMSE ATE (non-failed) [m] | RMSE ATE (all) [m] | "
-        "drift per 100 m (non-failed, mean) [m] | failures | scans degenerate / with degenerate "
-        "directions / all | median ms/scan (wall) | p95 ms/scan (wall) | median CPU ms/scan |\n"
+        "drift per 100 m (non-failed, mean) [m] | failures | scans degenerate / degen_dir / all | "
+        "median ms/scan (wall) | p95 ms/scan (wall) | median CPU ms/scan |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PooledCell& c : cells) {
     char line[400];

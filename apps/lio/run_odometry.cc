@@ -483,6 +483,12 @@ void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>
 
 void WriteScanLog(const std::string& path, const RunSummary& run) {
   std::ofstream f = io::OpenForWriting(path);
+  // Two notions (evaluation.txt and the summary use the same names): status `degenerate` (the
+  // lidar did not fix the pose: degenerate_scans) and degen_dirs > 0 (the lidar term had a
+  // degenerate direction, whatever the status: degenerate_direction_scans).
+  f << "# status degenerate: the lidar did not fix the pose (evaluation.txt degenerate_scans); "
+       "degen_dirs > 0: the lidar term had a degenerate direction, whatever the status "
+       "(evaluation.txt degenerate_direction_scans)\n";
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
        "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z imu_rejected "
        "points_dropped degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info "

@@ -10,14 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "common/command_line.h"
 #include "ctlio/study/evaluation.h"
 #include "ctlio/study/study.h"
 
 DEFINE_string(seeds, "20250301,1,2,3", "comma-separated seeds");
 DEFINE_int32(validation, 100, "validation trajectories");
-DEFINE_double(accel_rate, 400.0, "accelerometer rate (Hz)");
-DEFINE_double(sigma_acc, 0.05, "accelerometer noise");
-DEFINE_double(sigma_pos, 0.01, "position noise");
+DEFINE_double(accel_rate, 400.0, "accelerometer rate [Hz]");
+DEFINE_double(sigma_acc, 0.05, "accelerometer noise σ [m/s²]");
+DEFINE_double(sigma_pos, 0.01, "position noise σ [m]");
 DEFINE_int32(threads, 2, "threads");
 DEFINE_int32(set_id, 1, "random stream (1 validation, 2 test)");
 DEFINE_bool(measurement, false, "also train sigma^2, alpha (IMU as measurement)");
@@ -26,8 +27,15 @@ DEFINE_int32(test, 1000, "test trajectories for --nees_q");
 
 using namespace ctlio::study;
 
+constexpr char kUsage[] =
+    "ctlio_study_1d_calibration: how the maximum-likelihood input covariance Q_k of IMU as input\n"
+    "(and sigma^2, alpha of IMU as measurement) depends on the seed and the validation size.\n"
+    "\n"
+    "  ctlio_study_1d_calibration --seeds=20250301,1,2,3 --validation=100\n"
+    "  ctlio_study_1d_calibration --nees_q=0.01,0.02 --test=1000";
+
 int main(int argc, char** argv) {
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   std::vector<uint64_t> seeds;
   std::stringstream ss(FLAGS_seeds);
   for (std::string s; std::getline(ss, s, ',');) seeds.push_back(std::stoull(s));
