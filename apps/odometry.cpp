@@ -12,7 +12,8 @@
 //                  --config data/newer_college_lio.yaml --out DIR
 //
 // Writes DIR/trajectory.tum (T_world_lidar at every scan end, TUM `t x y z qx qy qz qw`), with
-// --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses),
+// --trajectory_rate HZ also DIR/trajectory_dense.tum (the estimate at HZ between scan poses, from
+// the final estimates: continuous) and DIR/trajectory_dense_live.tum (as returned live, causal),
 // DIR/scans.log (one line per scan: status, residual counts, iterations, time, the degenerate
 // directions of the lidar term: docs/user-guide/outputs.md) and, when the
 // source has ground truth, DIR/ground_truth.tum and DIR/evaluation.txt (ATE after SE(3) Umeyama
@@ -85,7 +86,9 @@ DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an S
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_double(trajectory_rate, 0.0,
               "Also write trajectory_dense.tum, the estimate at this rate [Hz] between the scan "
-              "poses (Singer-LIO: GP interpolation; baseline: IMU propagation); 0 = off");
+              "poses from the final estimates (Singer-LIO: GP interpolation; baseline: IMU "
+              "propagation anchored at both states), and trajectory_dense_live.tum, the live "
+              "(causal) one; 0 = off");
 DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
@@ -424,7 +427,12 @@ int main(int argc, char** argv) {
       if (!run.dense.empty()) {
         io::WriteTum(out + "/trajectory_dense.tum", run.dense);
         files.Add(out + "/trajectory_dense.tum",
-                  "the estimate at --trajectory_rate between scans (TUM)");
+                  "the continuous-time estimate at --trajectory_rate from the final estimates (TUM)");
+      }
+      if (!run.dense_live.empty()) {
+        io::WriteTum(out + "/trajectory_dense_live.tum", run.dense_live);
+        files.Add(out + "/trajectory_dense_live.tum",
+                  "the same rate as returned live, scan by scan (causal; TUM)");
       }
       lioapp::WriteScanLog(out + "/scans.log", run);
       files.Add(out + "/scans.log", "one line per scan: status, residuals, times [ms], degeneracy");
@@ -472,6 +480,10 @@ int main(int argc, char** argv) {
         if (!run.dense.empty()) {
           ev << "dense_ate_rmse_m " << lioapp::EvaluateAte(run.dense, *source->GroundTruth()).rmse
              << "\ndense_poses " << run.dense.size() << "\n";
+        }
+        if (!run.dense_live.empty()) {
+          ev << "dense_live_ate_rmse_m "
+             << lioapp::EvaluateAte(run.dense_live, *source->GroundTruth()).rmse << "\n";
         }
         ev << "ate_alignment";
         for (int r = 0; r < 4; ++r) {

@@ -4,11 +4,14 @@
 usage: plot_odometry.py <out_dir> <method_dir> [<method_dir> ...]
 
 Each method folder is what ctlio_odometry writes: trajectory.tum (scan-end poses),
-trajectory_dense.tum (optional, --trajectory_rate), scans.log, evaluation.txt and, with ground
-truth, ground_truth.tum and pose_errors.csv (aligned scan poses and their position/rotation
-errors). Writes <method_dir>/odometry.png and, for several methods, <out_dir>/comparison.png:
+trajectory_dense.tum and trajectory_dense_live.tum (optional, --trajectory_rate: the dense
+trajectory from the final estimates, and the live one stitched from each scan's window as it was
+returned), scans.log, evaluation.txt and, with ground truth, ground_truth.tum and pose_errors.csv
+(aligned scan poses and their position/rotation errors). Writes <method_dir>/odometry.png and,
+for several methods, <out_dir>/comparison.png:
   * top view (x-y) and side view (x-z) in metres: ground truth, the estimate at the densest rate
-    written, the scan poses as dots;
+    written ("dense, final estimates"; in the single-method figure also "dense, live, causal"),
+    the scan poses as dots;
   * position error [cm] and rotation error [deg] over time;
   * per-scan CPU time [ms] of the scan thread over time, coloured by scan status; degenerate, IMU-gap and failed
     scans marked, gaps in the scan sequence shaded.
@@ -113,6 +116,8 @@ class Run:
         dense = read_tum(os.path.join(folder, "trajectory_dense.tum"))
         self.dense = len(dense) > len(self.scan_poses)
         self.path = [align(r[1:4]) for r in dense] if self.dense else self.scan_poses
+        live = read_tum(os.path.join(folder, "trajectory_dense_live.tum"))
+        self.live_path = [align(r[1:4]) for r in live] if len(live) > len(self.scan_poses) else []
         self.truth = read_tum(os.path.join(folder, "ground_truth.tum"))
         if self.truth and self.scan_t:
             lo, hi = self.scan_t[0] - 0.05, self.scan_t[-1] + 0.05
@@ -135,13 +140,17 @@ def draw_views(ax_top, ax_side, runs, single):
                     label="ground truth", zorder=1)
         for k, run in enumerate(runs):
             colour = METHOD_COLOURS[k % len(METHOD_COLOURS)]
-            rate = "dense" if run.dense else "scan poses"
+            rate = "dense, final estimates" if run.dense else "scan poses"
             label = "estimate (%s)" % rate if single else "%s (%s)" % (run.method, rate)
             ax.plot([p[i - 1] for p in run.path], [p[j - 1] for p in run.path], color=colour,
                     lw=1.2, label=label, zorder=2)
+            if single and run.live_path:
+                ax.plot([p[i - 1] for p in run.live_path], [p[j - 1] for p in run.live_path],
+                        color="#1f77b4", lw=0.8, ls="--", label="estimate (dense, live, causal)",
+                        zorder=2)
             if single:
                 ax.plot([p[i - 1] for p in run.scan_poses], [p[j - 1] for p in run.scan_poses],
-                        ".", color=colour, ms=4, label="scan-end poses", zorder=3)
+                        ".", color=colour, ms=4, label="scan-end poses (live)", zorder=3)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]" if j == 2 else "z [m]")
         ax.set_aspect("equal", adjustable="datalim")

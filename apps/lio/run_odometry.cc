@@ -224,6 +224,7 @@ void ResetTally(RunSummary* run) {
   run->final_biases.clear();
   run->trajectory.clear();
   run->dense.clear();
+  run->dense_live.clear();
   run->scans.clear();
 }
 
@@ -275,6 +276,11 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   if (const auto g = source.Gravity()) config.gravity = *g;
   // The odometry applies the input gates (config.input); the runner only reports them.
   auto odometry = lio::MakeLioOdometry(config);
+  odometry->SampleFinalTrajectory(options.trajectory_rate_hz);
+  // T_mr first; T_imu_lidar at the end (below).
+  const auto take_final = [&](const std::vector<std::pair<int64_t, SE3>>& samples) {
+    for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr});
+  };
   auto warn = [&](const std::string& m) {
     LOG(WARNING) << source.Name() << ": " << m;
     if (run.first_input_warning.empty()) run.first_input_warning = m;
@@ -340,13 +346,14 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     if (r.revised_scans > 0) {
       // The calibration warm-up replay replaced the earlier scans' results: tally those instead
-      // (their dense samples are gone with the pipeline that made them: the scan poses stand in).
+      // (their live dense samples are gone with the pipeline that made them: the scan poses stand
+      // in; the final ones are the replay's, taken below).
       const std::deque<lio::ScanResult>& all = odometry->results();
       ResetTally(&run);
       for (size_t i = 0; i + 1 < all.size(); ++i) {
         Tally(all[i], i, T_imu_lidar, &run);
         if (all[i].status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
-          run.dense.push_back(run.trajectory.back());
+          run.dense_live.push_back(run.trajectory.back());
         }
       }
       run.warmup_replayed_scans = r.revised_scans;
@@ -358,10 +365,15 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       const SE3& T_rl = r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar;
       auto samples = odometry->SampleNewestInterval(options.trajectory_rate_hz);
       if (samples.empty()) samples.emplace_back(r.t_ns, r.T_mr);  // the first state
-      for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr * T_rl});
+      for (const auto& [t, T_mr] : samples) run.dense_live.push_back({t, T_mr * T_rl});
     }
+    take_final(odometry->TakeFinalTrajectory());
     if (options.progress) options.progress(done, total, r);
   }
+  take_final(odometry->FinalTrajectoryTail());  // the window's estimates are final now
+  // The extrinsic is one static state: its final estimate for every pose (each scan's own
+  // estimate would put its changes into the trajectory as jumps).
+  for (io::StampedPose& p : run.dense) p.pose = p.pose * run.final_extrinsic;
   // The first scan (map creation) is not a registration: keep it out of the latency figures.
   std::vector<double> reg(ms.begin() + std::min<size_t>(1, ms.size()), ms.end());
   run.median_ms = Percentile(reg, 0.5);

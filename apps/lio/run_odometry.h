@@ -21,7 +21,8 @@ struct RunOptions {
   // otherwise the source's (a bag's /tf_static, then a dataset preset or the dataset's files; see
   // DataSource::ExtrinsicOrigin). The choice is logged and kept in RunSummary::extrinsic_origin.
   bool extrinsic_from_config = false;
-  // > 0: also sample the estimate at this rate between the scan poses (RunSummary::dense).
+  // > 0: also sample the estimate at this rate between the scan poses (RunSummary::dense and
+  // dense_live).
   double trajectory_rate_hz = 0.0;
   // > 0: each scan is given to the odometry no earlier than its end time after the first scan's,
   // divided by this factor, on the wall clock (1 = the sensor's own pace, as `rosbag play -r`):
@@ -55,9 +56,14 @@ struct RunSummary {
   // estimated (failed scans are left out, never written as garbage); with the extrinsic
   // estimated online (calibration.estimate_extrinsic), T_mr·T_imu_lidar of that scan's estimate.
   std::vector<io::StampedPose> trajectory;
-  // With RunOptions::trajectory_rate_hz: T_world_lidar at that rate (LioOdometry::
-  // SampleNewestInterval after every estimated scan), ending at each scan pose.
+  // With RunOptions::trajectory_rate_hz: T_world_lidar at that rate from the final estimates
+  // (LioOdometry::TakeFinalTrajectory: each segment between two states once both have left the
+  // window, the rest at the end; continuous at every state, in pieces around failed scans; with
+  // the final extrinsic estimate when it is estimated), and the live,
+  // causal one (SampleNewestInterval after every estimated scan, ending at each scan pose as
+  // returned; it jumps where the next scan's window revised the previous state).
   std::vector<io::StampedPose> dense;
+  std::vector<io::StampedPose> dense_live;
   std::vector<lio::ScanResult> scans;
   // Calibration warm-up replay (calibration.warmup_replay_s): how many earlier scans it revised
   // (0: none), and the trajectory as returned live, scan by scan, before the replay revised its

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "common/dense_trajectory_checks.h"
@@ -159,10 +160,14 @@ TEST(KnotsPerScan, TimeOffsetSamplesFollowOnAcrossTheIntervals) {
 
 // On a sparse fast sequence (16 beams, every 8th firing, 1.5 s) two knots per scan track the
 // motion better than one (measured RMSE 3.0 cm against 9.8 cm: the 4–8 Hz motion is
-// interpolated over 50 instead of 100 ms), and the dense trajectory at 100 Hz has a pose every
+// interpolated over 50 instead of 100 ms), the live dense trajectory at 100 Hz has a pose every
 // 10 ms through every scan, ends each scan at its pose, and is smooth across the interior knots:
 // the second difference of its positions at 10 ms stays below 1 cm (the truth's reaches 5.4 mm,
-// ~50 m/s²; an interval read with the wrong knots would be off by the 14 cm moved in 50 ms).
+// ~50 m/s²; an interval read with the wrong knots would be off by the 14 cm moved in 50 ms). The
+// final estimates' trajectory has no jump at a scan boundary; it bends more inside the sweeps'
+// second intervals, whose two knots are final in different windows (the scan-end knot is
+// revised once more after the interior one has left): 2.0 cm measured, bounded by 3 cm, still
+// far from a wrong-knot read, and it is the more accurate one (ATE 1.9 against 2.1 cm).
 TEST(KnotsPerScan, TracksAFastSequenceWithASmoothDenseTrajectory) {
   OdometryConfig config = testing::SimLioConfig();
   sim::SimulatedSource one_source(ShortSequence(sim::Regime::kFast));
@@ -176,20 +181,28 @@ TEST(KnotsPerScan, TracksAFastSequenceWithASmoothDenseTrajectory) {
   ASSERT_TRUE(run.ate.has_value() && one.ate.has_value());
   EXPECT_LT(run.ate->rmse, 0.05);
   EXPECT_LT(run.ate->rmse, 0.6 * one.ate->rmse);
-  const auto& dense = run.dense;
-  EXPECT_GE(dense.size(), 130u);
+  EXPECT_GE(run.dense.size(), 130u);
   ASSERT_NO_FATAL_FAILURE(testing::ExpectDenseThroughTheScanPoses(run, 10'000'000));
-  double max_second_difference = 0.0;
-  for (size_t i = 1; i + 1 < dense.size(); ++i) {
-    if (dense[i + 1].t_ns - dense[i].t_ns == 10'000'000 &&
-        dense[i].t_ns - dense[i - 1].t_ns == 10'000'000) {
-      const Vec3 d2 = dense[i + 1].pose.translation() - 2.0 * dense[i].pose.translation() +
-                      dense[i - 1].pose.translation();
-      max_second_difference = std::max(max_second_difference, d2.norm());
+  const auto max_second_difference = [](const std::vector<io::StampedPose>& dense) {
+    double largest = 0.0;
+    for (size_t i = 1; i + 1 < dense.size(); ++i) {
+      if (dense[i + 1].t_ns - dense[i].t_ns == 10'000'000 &&
+          dense[i].t_ns - dense[i - 1].t_ns == 10'000'000) {
+        const Vec3 d2 = dense[i + 1].pose.translation() - 2.0 * dense[i].pose.translation() +
+                        dense[i - 1].pose.translation();
+        largest = std::max(largest, d2.norm());
+      }
     }
+    return largest;
+  };
+  EXPECT_LT(max_second_difference(run.dense_live), 0.01);
+  EXPECT_GT(max_second_difference(run.dense_live), 0.0);
+  EXPECT_LT(max_second_difference(run.dense), 0.03);
+  std::vector<int64_t> boundaries;
+  for (size_t i = 1; i + 1 < run.trajectory.size(); ++i) {
+    boundaries.push_back(run.trajectory[i].t_ns);
   }
-  EXPECT_LT(max_second_difference, 0.01);
-  EXPECT_GT(max_second_difference, 0.0);
+  EXPECT_LE(testing::MaxBoundaryStepRatio(run.dense, boundaries), 1.5);
 }
 
 }  // namespace

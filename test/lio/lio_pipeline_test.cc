@@ -134,7 +134,9 @@ TEST(LioPipeline, IntervalResidualBlocksGiveThePerPointEstimates) {
 // they share, so the same estimates bit for bit, for both methods (each inserts its own deskewed
 // points), also with online calibration (the preprocessing reads the extrinsic estimate before the
 // window slides), whether the scans come back to back or paced (RunOptions::play_rate: the
-// insertion then ends in the idle time between sweeps, a different interleaving).
+// insertion then ends in the idle time between sweeps, a different interleaving). So is the dense
+// trajectory from the final estimates, sealed beside the preprocessing before each
+// marginalisation (the baseline's reads the IMU there).
 TEST(LioPipeline, OverlappedStagesGiveTheSameEstimates) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
     for (const bool calibrate : {false, true}) {
@@ -144,12 +146,14 @@ TEST(LioPipeline, OverlappedStagesGiveTheSameEstimates) {
       serial.calibration.warmup_replay_s = 0.5;  // a replay inside the run, overlapped too
       OdometryConfig overlapped = serial;
       overlapped.overlap_stages = true;
+      lioapp::RunOptions dense;
+      dense.trajectory_rate_hz = 100.0;
       sim::SimulatedSource serial_source(ShortSequence());
-      const lioapp::RunSummary a = lioapp::RunOdometry(serial_source, serial);
+      const lioapp::RunSummary a = lioapp::RunOdometry(serial_source, serial, dense);
       sim::SimulatedSource overlapped_source(ShortSequence());
-      const lioapp::RunSummary b = lioapp::RunOdometry(overlapped_source, overlapped);
+      const lioapp::RunSummary b = lioapp::RunOdometry(overlapped_source, overlapped, dense);
       sim::SimulatedSource paced_source(ShortSequence());
-      lioapp::RunOptions paced;
+      lioapp::RunOptions paced = dense;
       paced.play_rate = 5.0;  // 10 scans of 0.1 s in 0.18 s or more of wall time
       const auto start = std::chrono::steady_clock::now();
       const lioapp::RunSummary c = lioapp::RunOdometry(paced_source, overlapped, paced);
@@ -162,6 +166,14 @@ TEST(LioPipeline, OverlappedStagesGiveTheSameEstimates) {
       EXPECT_EQ(a.warmup_replayed_scans, c.warmup_replayed_scans);
       // The last scan is given no earlier than 9 sweeps (0.9 s of data) / 5 after the first.
       EXPECT_GE(seconds, 0.9 / 5.0);
+      ASSERT_GE(a.dense.size(), 80u);
+      ASSERT_EQ(a.dense.size(), b.dense.size());
+      ASSERT_EQ(a.dense.size(), c.dense.size());
+      for (size_t i = 0; i < a.dense.size(); ++i) {
+        EXPECT_EQ(a.dense[i].t_ns, b.dense[i].t_ns);
+        EXPECT_EQ(a.dense[i].pose.Matrix(), b.dense[i].pose.Matrix()) << "dense " << i;
+        EXPECT_EQ(a.dense[i].pose.Matrix(), c.dense[i].pose.Matrix()) << "dense, paced " << i;
+      }
       for (size_t i = 0; i < a.trajectory.size(); ++i) {
         EXPECT_EQ(a.trajectory[i].pose.Matrix(), b.trajectory[i].pose.Matrix())
             << LioMethodName(m) << (calibrate ? " calibrating" : "") << " scan " << i;

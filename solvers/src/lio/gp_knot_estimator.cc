@@ -92,12 +92,56 @@ SE3 GpKnotEstimator::PoseSinceScanStart(double tau) const {
   return PoseAt(knots_[j], knots_[j + 1], tau);
 }
 
+GpKnotEstimator::TimedState GpKnotEstimator::ValueOf(const Knot& k) {
+  return {k.t, gp::ReadKnotState(k.pose, k.velocity, k.acceleration)};
+}
+
 SE3 GpKnotEstimator::PoseAt(const Knot& a, const Knot& b, double tau) const {
+  return PoseBetween(ValueOf(a), ValueOf(b), tau);
+}
+
+SE3 GpKnotEstimator::PoseBetween(const TimedState& a, const TimedState& b, double tau) const {
   const gp::GpInterpolator interp(model_, a.t, b.t, std::clamp(tau, a.t, b.t));
   SE3 T_rm;
-  interp.Pose(gp::ReadKnotState(a.pose, a.velocity, a.acceleration),
-              gp::ReadKnotState(b.pose, b.velocity, b.acceleration), &T_rm, nullptr, nullptr);
+  interp.Pose(a.x, b.x, &T_rm, nullptr, nullptr);
   return T_rm.Inverse();
+}
+
+std::vector<SE3> GpKnotEstimator::PosesOver(const std::vector<TimedState>& chain,
+                                            const std::vector<double>& t) const {
+  std::vector<SE3> poses;
+  poses.reserve(t.size());
+  size_t j = 0;  // the first knot at or after τ (or the last)
+  for (const double tau : t) {
+    while (j + 1 < chain.size() && chain[j].t < tau) ++j;
+    poses.push_back(j == 0 || tau >= chain[j].t ? chain[j].x.pose.Inverse()
+                                                : PoseBetween(chain[j - 1], chain[j], tau));
+  }
+  return poses;
+}
+
+std::vector<double> GpKnotEstimator::StateTimes() const {
+  std::vector<double> t;
+  for (const Knot& k : knots_) t.push_back(k.t);
+  return t;
+}
+
+std::vector<SE3> GpKnotEstimator::SealOldest(const std::vector<double>& t) {
+  // Both knots' full GP states at their final values: the interpolation of the factors (SPEC §2)
+  // between them is the final estimate of the interval.
+  std::vector<TimedState> chain;
+  if (sealed_) chain.push_back(*sealed_);
+  chain.push_back(ValueOf(knots_.front()));
+  std::vector<SE3> poses = PosesOver(chain, t);
+  sealed_ = chain.back();
+  return poses;
+}
+
+std::vector<SE3> GpKnotEstimator::UnsealedPoses(const std::vector<double>& t) const {
+  std::vector<TimedState> chain;
+  if (sealed_) chain.push_back(*sealed_);
+  for (const Knot& k : knots_) chain.push_back(ValueOf(k));
+  return PosesOver(chain, t);
 }
 
 SE3 GpKnotEstimator::NewestPose() const { return PoseManifold::Pose(knots_.back().pose).Inverse(); }

@@ -118,6 +118,17 @@ std::vector<std::pair<int64_t, SE3>> LioOdometry::SampleNewestInterval(double ra
   return out;
 }
 
+FinalTrajectory::Samples LioOdometry::TakeFinalTrajectory() {
+  if (replay_ != nullptr) return replay_->TakeFinalTrajectory();
+  return final_trajectory_.Take();
+}
+
+FinalTrajectory::Samples LioOdometry::FinalTrajectoryTail() const {
+  if (replay_ != nullptr) return replay_->FinalTrajectoryTail();
+  if (!initialised_) return {};
+  return final_trajectory_.Tail(*estimator_, imu_.origin_ns());
+}
+
 bool LioOdometry::AddImu(const ImuSample& sample) {
   if (replay_ != nullptr) return replay_->AddImu(sample);
   if (sample.imu >= config_.num_imus()) {
@@ -179,6 +190,7 @@ void LioOdometry::MaybeReplayWarmup(ScanResult* result) {
       replay_config.calibration.estimate_extrinsic = false;
     }
     replay = std::make_unique<LioOdometry>(replay_config);
+    replay->SampleFinalTrajectory(final_trajectory_.rate());
     if (freeze) {
       replay->frozen_calibration_ = Frozen(start_values, replay_config);
     }
@@ -289,6 +301,9 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
   result.ms_preprocess = MsSince(start);
   result.t_ns = scan.end_ns;
   result.keypoints = static_cast<int>(prepared.keypoints.size());
+  // The states this scan adds have times in (previous scan end, scan end].
+  const bool had_state = initialised_;
+  const double t_previous = imu_.Seconds(last_scan_end_ns_);
   try {
     // Joined before anything reads the map or the window; rethrows what the thread threw. The
     // second thread's times go into this scan's map and marginalise columns.
@@ -309,6 +324,9 @@ ScanResult LioOdometry::RunScan(const LidarScan& input) {
     if (!initialised_) last_scan_end_ns_ = scan.end_ns;
   }
   if (!dropped_note.empty()) AddNote(&result, dropped_note);
+  if (had_state && result.status == ScanStatus::kFailed) {
+    final_trajectory_.MarkFailed(t_previous, prepared.t_end);
+  }
   const ImuBuffer::Rejections rejected = imu_.TakeRejections();
   if (rejected.count > 0) {
     result.imu_rejected = static_cast<int>(rejected.count);
@@ -567,6 +585,7 @@ void LioOdometry::Slide(ScanResult* result) {
 double LioOdometry::SlideWindow() {
   const auto t0 = std::chrono::steady_clock::now();
   while (estimator_->num_states() > config_.window_knots - 1) {
+    final_trajectory_.SealOldest(estimator_.get(), imu_.origin_ns());
     last_marginalization_ = window_.Marginalize(estimator_->OldestKeys());
     ++num_marginalizations_;
     estimator_->DropOldest();

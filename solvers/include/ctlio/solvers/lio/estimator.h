@@ -73,6 +73,17 @@ class Estimator {
   // propagated from the previous state and anchored at the newest, as its deskewing does.
   virtual double previous_time() const = 0;
   virtual std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const = 0;
+  // The dense trajectory from the final estimates (final_trajectory.h): the times of the states
+  // in the window, oldest first. SealOldest is called right before the window marginalises the
+  // oldest state, whose estimate is final then: it keeps that final value and returns T_mr at `t`
+  // (ascending, in (s, oldest] for the state s sealed before it) on the segment between the two,
+  // both ends at their final values, by the same motion model as PosesSincePrevious (the
+  // baseline's propagation anchored at both ends); at the oldest's time its pose exactly.
+  // UnsealedPoses: the same over the segments from the state sealed last through the window's
+  // states, from their current estimates (final once no scan follows), at `t` in (s, newest].
+  virtual std::vector<double> StateTimes() const = 0;
+  virtual std::vector<SE3> SealOldest(const std::vector<double>& t) = 0;
+  virtual std::vector<SE3> UnsealedPoses(const std::vector<double>& t) const = 0;
 
   // How an IMU gap is bridged (for the scan's status message).
   virtual std::string ImuGapRecovery() const = 0;

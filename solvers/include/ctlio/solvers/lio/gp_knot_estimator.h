@@ -22,6 +22,7 @@
 
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,9 @@ class GpKnotEstimator final : public Estimator {
   Mat6 NewestPoseTangentFromBody() const override { return -Mat6::Identity(); }
   double previous_time() const override { return ScanStart().t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
+  std::vector<double> StateTimes() const override;
+  std::vector<SE3> SealOldest(const std::vector<double>& t) override;
+  std::vector<SE3> UnsealedPoses(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
 
  private:
@@ -74,8 +78,20 @@ class GpKnotEstimator final : public Estimator {
   // `bias`: the initial value of every IMU's bias, per IMU.
   Knot AddKnot(double t, const SE3& T_rm, const Vec6& w, const Vec6& dw,
                const std::vector<Vec6>& bias, SlidingWindow* window);
-  // T_mr(τ) between knots a and b from the current estimates (GP interpolation, SPEC §2).
+  // A knot's time and its GP state {T_rm, ϖ, ϖ̇}: what the interpolation between knots reads.
+  struct TimedState {
+    double t = 0.0;
+    gp::KnotState x;
+  };
+  static TimedState ValueOf(const Knot& k);
+  // T_mr(τ) between knots a and b from the current estimates (GP interpolation, SPEC §2), and
+  // between two knot states.
   SE3 PoseAt(const Knot& a, const Knot& b, double tau) const;
+  SE3 PoseBetween(const TimedState& a, const TimedState& b, double tau) const;
+  // T_mr at each of `t` (ascending) over consecutive knot states (time order): at a knot's time
+  // its pose, between two knots the interpolation.
+  std::vector<SE3> PosesOver(const std::vector<TimedState>& chain,
+                             const std::vector<double>& t) const;
   // The knot at the previous scan's end (the newest before the last AddState), its index in
   // knots_, and T_mr(τ) for τ in [ScanStart().t, newest_time()] on the interval between the
   // knots around τ.
@@ -110,6 +126,7 @@ class GpKnotEstimator final : public Estimator {
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
+  std::optional<TimedState> sealed_;       // the final value of the knot sealed last
 };
 
 }  // namespace ctlio::lio

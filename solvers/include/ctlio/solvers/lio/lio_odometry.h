@@ -25,6 +25,7 @@
 
 #include "ctlio/solvers/lio/calibration_observability.h"
 #include "ctlio/solvers/lio/estimator.h"
+#include "ctlio/solvers/lio/final_trajectory.h"
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/imu_buffer.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -85,6 +86,14 @@ class LioOdometry {
   const std::vector<Vec3>* newest_map_points() const {
     return active().map_points_inserted_ ? &active().map_points_ : nullptr;
   }
+  // The dense trajectory from the final estimates (final_trajectory.h): T_mr every 1/rate_hz s
+  // (0, the default: none; set before the first scan). A warm-up replay's pipeline carries it on
+  // from its own first scan (the replay revised the span's estimates). TakeFinalTrajectory: the
+  // samples of the segments sealed since the previous call, time order; FinalTrajectoryTail: the
+  // rest, from the state sealed last to the newest, once no scan follows.
+  void SampleFinalTrajectory(double rate_hz) { final_trajectory_.set_rate(rate_hz); }
+  FinalTrajectory::Samples TakeFinalTrajectory();
+  FinalTrajectory::Samples FinalTrajectoryTail() const;
 
  private:
   const LioOdometry& active() const { return replay_ != nullptr ? *replay_ : *this; }
@@ -180,6 +189,7 @@ class LioOdometry {
   SlidingWindow window_;
   ScanRegistration registration_;
   std::unique_ptr<Estimator> estimator_;
+  FinalTrajectory final_trajectory_;  // sealed in SlideWindow, before each marginalisation
 
   Mat3 C_mi_ = Mat3::Identity();
   int64_t last_scan_end_ns_ = 0;

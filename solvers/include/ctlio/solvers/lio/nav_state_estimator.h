@@ -15,6 +15,7 @@
 
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,9 @@ class NavStateEstimator final : public Estimator {
   Mat6 NewestPoseTangentFromBody() const override { return NewestPose().Adjoint(); }
   double previous_time() const override { return states_[states_.size() - 2].t; }
   std::vector<SE3> PosesSincePrevious(const std::vector<double>& t) const override;
+  std::vector<double> StateTimes() const override;
+  std::vector<SE3> SealOldest(const std::vector<double>& t) override;
+  std::vector<SE3> UnsealedPoses(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override;
 
   // A state's blocks live in the window.
@@ -80,12 +84,17 @@ class NavStateEstimator final : public Estimator {
                     SlidingWindow* window);
   // Across an IMU gap: the constant-twist prediction and the velocity random walk.
   void AddStateAcrossGap(const State& prev, double t_end, SlidingWindow* window);
+  // T_wb(τ) on the segment from a state to T_b at t_b, given `from_a`, the motion propagated from
+  // the state (Deskew): the propagation with its end mismatch against T_b spread over the segment.
+  static SE3 AnchoredPose(const DeskewTable& from_a, double t_b, const SE3& T_b, double tau);
 
   OdometryConfig config_;
   const ImuBuffer& imu_;
   Vec3 gravity_map_ = Vec3::Zero();
   std::deque<State> states_;  // oldest first
   int64_t next_state_ = 0;
+  // The motion propagated from the final value of the state sealed last to the next state's time.
+  std::optional<DeskewTable> sealed_;
 };
 
 }  // namespace ctlio::lio
