@@ -403,7 +403,8 @@ class WarningSink : public google::LogSink {
 
 TEST(BagRecovery, EmptyAllNonFiniteAndZeroDurationScansAreHandedOnAndCounted) {
   const fs::path d = testing::FreshTempDir("bag_recovery");
-  const int64_t period = 100'000'000;
+  // 20 Hz: the nominal interval follows the bag's stamp spacing, not the 0.1 s default.
+  const int64_t period = 50'000'000;
   std::vector<sensor_msgs::PointCloud2> clouds;
   for (int k = 0; k < 6; ++k) clouds.push_back(GoodCloud(kStamp + k * period));
   // Message 2: no points at all.

@@ -168,6 +168,9 @@ struct RosbagSource::Impl {
   int64_t last_imu_ns = INT64_MIN, last_scan_start_ns = INT64_MIN;
   size_t duplicates = 0;
   size_t unusable_scans = 0;  // handed on empty or with their nominal interval (AddScan)
+  // Header stamps of the lidar messages: the last one and the last spacing (the scan period as
+  // the bag shows it, for the nominal interval of an unusable scan).
+  int64_t last_lidar_stamp_ns = INT64_MIN, last_lidar_spacing_ns = 0;
   uint64_t bytes = 0;
   double accel_norm_sum = 0.0;
   bool azimuth_logged = false;
@@ -366,6 +369,10 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
   // A stamp at the scan start is the start (DataSource: start_ns = the scan stamp) even when the
   // first returns were dropped; otherwise the earliest point is.
   const int64_t stamp = f.cloud.stamp_ns;
+  if (last_lidar_stamp_ns != INT64_MIN && stamp > last_lidar_stamp_ns) {
+    last_lidar_spacing_ns = stamp - last_lidar_stamp_ns;  // no overflow: both are ≥ 0 (ros::Time)
+  }
+  last_lidar_stamp_ns = stamp;
   f.start_ns = f.end_ns = stamp;
   if (f.cloud.has_times() && !f.cloud.points.empty()) {
     const auto [lo, hi] = std::minmax_element(f.cloud.times_ns.begin(), f.cloud.times_ns.end());
@@ -376,8 +383,10 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
     // Recovery, as in the folder readers (README "Bad input"): a cloud without usable points
     // (empty, all non-finite) or with every point at one instant gives no interval; it is handed on
     // with its nominal one (one scan period from the stamp, or up to it for a stamp at the scan
-    // end) and the odometry reports it degenerate when it has no points.
-    const int64_t period = std::max<int64_t>(options.time.scan_period_ns, 2);
+    // end; the period is the last stamp spacing, so that the interval ends before the next scan,
+    // else scan_period_ns) and the odometry reports it degenerate when it has no points.
+    const int64_t period = std::max<int64_t>(
+        last_lidar_spacing_ns > 0 ? last_lidar_spacing_ns : options.time.scan_period_ns, 2);
     const bool at_end = layout.convention.stamp_at == StampAt::kScanEnd;
     int64_t lo = stamp, hi = stamp;
     const bool overflow = at_end ? __builtin_sub_overflow(stamp, period - 1, &lo)
