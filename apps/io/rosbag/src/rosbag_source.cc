@@ -416,8 +416,8 @@ void RosbagSource::Impl::ReadOne() {
   try {
     const rosbag::MessageInstance& m = *it;
     bytes += m.size();
-    // Message numbers count every message of the topic, read or not, so that an error names the
-    // message it is about (never the one after it).
+    // `where` names the message being read (AddImu advances the IMU count itself), so that a
+    // library error names it too, never the one after it.
     if (m.getTopic() == imu_topic) {
       where = Where(imu_topic, imu_messages + 1);
       AddImu(ReadCheckedMessage<sensor_msgs::Imu>(m, where, nullptr));
