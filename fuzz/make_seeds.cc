@@ -108,6 +108,9 @@ int main(int argc, char** argv) {
       io::WriteRosbag(bag_source, (work / "s.bag").string(), o);
       Seed(corpus, "rosbag", compression, Read(work / "s.bag"));
     }
+    // The structure-aware target builds its valid message itself; its inputs are edit recipes,
+    // and the empty one (no edit) is the valid message.
+    Seed(corpus, "pointcloud2", "unchanged", "");
     for (const auto& e : fs::directory_iterator(source_dir / "data")) {
       if (e.path().extension() == ".yaml") {
         Seed(corpus, "yaml_config", e.path().filename().string(), Read(e.path()));

@@ -3,6 +3,8 @@
 # seed corpora from the simulator and runs every target for SECONDS (default 60) each.
 #   scripts/fuzz.sh [SECONDS] [BUILD_DIR]        (default build dir: build-fuzz)
 #   CTLIO_FUZZ_TARGETS="pcd table" scripts/fuzz.sh 600   runs a subset, 10 minutes each
+# Memory is bounded (-rss_limit_mb=1024, and with it -malloc_limit_mb): every input is < 64 KiB, so
+# a reader that needs 1 GB has allocated from a count the input cannot hold — a finding.
 # The corpus grows in BUILD_DIR/corpus/<target> across runs; a crash or sanitizer report stops
 # the script with the reproducer in BUILD_DIR/artifacts/ (rerun: BUILD_DIR/fuzz/fuzz_<target>
 # <file>).
@@ -15,7 +17,8 @@ seconds=${1:-60}
 build_dir=${2:-build-fuzz}
 # rosbag: RosbagSource over Debian's uninstrumented librosbag, behind ctlio's bag structure check
 # (docs/developer-guide/fuzzing.md); 5 minutes clean when it was added.
-targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config euroc rosbag"}
+# pointcloud2: structure-aware, edits the decoded fields of a simulated PointCloud2 message.
+targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config euroc rosbag pointcloud2"}
 bash scripts/install_deps.sh
 
 start=$(date +%s)
@@ -56,7 +59,7 @@ for t in $targets; do
   echo "fuzz: $t for $seconds s"
   log="$build_dir/fuzz_$t.log"
   if ! "$build_dir/fuzz/fuzz_$t" "$corpus/$t" -max_total_time="$seconds" -timeout=10 \
-    -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts/$t-" \
+    -rss_limit_mb=1024 -max_len=65536 -print_final_stats=1 -artifact_prefix="$artifacts/$t-" \
     >"$log" 2>&1; then
     tail -n 60 "$log"
     echo "fuzz: $t FAILED (reproducer in $artifacts/, full log $log)"

@@ -122,7 +122,18 @@ TEST(ReaderHardening, ZeroQuaternionInTheCtlioYamlIsAnError) {
     if (k != std::string::npos) l = l.substr(0, k) + "quaternion_xyzw: [0, 0, 0, 0]";
   }
   WriteLines(d / "ctlio_sim.yaml", lines);
-  ExpectError([&] { SimFolderReader r(d.string()); }, {"ctlio_sim.yaml", "quaternion norm 0"});
+  ExpectError([&] { SimFolderReader r(d.string()); },
+              {"ctlio_sim.yaml", "quaternion is not a rotation: |q|^2 = 0"});
+  // NaN in a translation (the shared extrinsic check, as for a bag's /tf_static).
+  const fs::path n = CtlioFixture("nan_t");
+  lines = Lines(n / "ctlio_sim.yaml");
+  for (auto& l : lines) {
+    const size_t k = l.find("translation:");
+    if (k != std::string::npos) l = l.substr(0, k) + "translation: [0, .nan, 0]";
+  }
+  WriteLines(n / "ctlio_sim.yaml", lines);
+  ExpectError([&] { SimFolderReader r(n.string()); },
+              {"ctlio_sim.yaml", "translation is not finite"});
 }
 
 // Replaces one Newer College scan by an ascii PCD with the given fields and rows.

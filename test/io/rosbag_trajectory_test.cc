@@ -85,5 +85,64 @@ TEST(RosbagTrajectory, FolderAndBagGiveTheSameTrajectory) {
   }
 }
 
+// A simulated sequence whose scan `empty` has no points and whose scan `instant` has every point at
+// its stamp (a driver that wrote no per-point times): unusable scans of a bag.
+class UnusableScans : public DataSource {
+ public:
+  UnusableScans(const sim::SimConfig& c, size_t empty, size_t instant)
+      : source_(c), empty_(empty), instant_(instant) {}
+  std::string Name() const override { return source_.Name(); }
+  size_t NumScans() const override { return source_.NumScans(); }
+  SE3 ImuFromLidar() const override { return source_.ImuFromLidar(); }
+  std::optional<std::vector<StampedPose>> GroundTruth() const override {
+    return source_.GroundTruth();
+  }
+  std::optional<double> Gravity() const override { return source_.Gravity(); }
+  std::vector<ImuInfo> Imus() const override { return source_.Imus(); }
+  bool Next(ScanFrame* f) override {
+    if (!source_.Next(f)) return false;
+    if (f->index == empty_) {
+      PointCloud none;
+      none.stamp_ns = f->cloud.stamp_ns;
+      f->cloud = none;
+    }
+    if (f->index == instant_) {
+      for (int64_t& t : f->cloud.times_ns) t = f->cloud.stamp_ns;
+    }
+    return true;
+  }
+
+ private:
+  sim::SimulatedSource source_;
+  size_t empty_, instant_;
+};
+
+// Unusable scans in a bag do not abort the run (it used to end with exit 2 and nothing written):
+// the reader hands them on with their nominal interval and counts them, the odometry estimates
+// the rest and reports the empty one degenerate.
+TEST(RosbagTrajectory, UnusableScansInABagDoNotAbortTheRun) {
+  const auto d = testing::FreshTempDir("rosbag_unusable");
+  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 2);
+  c.duration_s = 1.0;
+  c.lidar.beams = 16;
+  c.lidar.firing_decimation = 8;
+  c.imu_from_lidar = NewerCollegeImuFromLidar();
+  c.start_ns = 1583836591LL * 1000000000LL + 182590000LL;
+  {
+    UnusableScans source(c, 5, 7);
+    WriteRosbag(source, (d / "run.bag").string());
+  }
+  lio::OdometryConfig config =
+      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  config.gravity = sim::SimulatedSource(c).Gravity().value();
+  RosbagSource bag((d / "run.bag").string());
+  const lioapp::RunSummary s = lioapp::RunOdometry(bag, config);
+  EXPECT_EQ(bag.unusable_scans(), 2u);
+  ASSERT_EQ(s.scans.size(), sim::SimulatedSource(c).NumScans());
+  EXPECT_GE(s.degenerate, 1);
+  ASSERT_TRUE(s.ate);
+  EXPECT_LT(s.ate->rmse, 0.1);
+}
+
 }  // namespace
 }  // namespace ctlio::io

@@ -79,6 +79,44 @@ TEST(OdometryConfig, BadValuesAreErrors) {
   }
 }
 
+// NaN or Inf anywhere in an extrinsic is an error naming the file, the line and the element (NaN
+// passes the rotation-matrix check, whose comparisons are false, and gave a NaN trajectory).
+TEST(OdometryConfig, NonFiniteExtrinsicNamesFileAndLine) {
+  struct Case {
+    const char* name;
+    const char* text;
+    const char* needle;
+  };
+  const Case cases[] = {
+      {"e_rpy.yaml", "method: singer_lio\nextrinsic:\n  xyz_rpy: [0, 0, 0, .nan, 0, 0]\n",
+       ":3: extrinsic.xyz_rpy[3] is .nan"},
+      {"e_xyz.yaml", "extrinsic:\n  xyz_rpy: [0, .inf, 0, 0, 0, 0]\n",
+       ":2: extrinsic.xyz_rpy[1] is .inf"},
+      {"e_rot.yaml",
+       "extrinsic:\n  rotation: [1, 0, 0,\n             0, .nan, 0,\n             0, 0, 1]\n",
+       ":3: extrinsic.rotation[4] is .nan"},
+      {"e_t.yaml", "extrinsic:\n  translation: [-.inf, 0, 0]\n",
+       ":2: extrinsic.translation[0] is -.inf"},
+      {"e_imu.yaml", "imus:\n  - xyz_rpy: [0, 0, 0, 0, .NaN, 0]\n",
+       ":2: imus[0].xyz_rpy[4] is .NaN"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = WriteTemp(c.name, c.text);
+    try {
+      LoadOdometryConfig(path);
+      ADD_FAILURE() << c.name << ": no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + c.needle), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("must be finite"), std::string::npos) << e.what();
+    }
+  }
+  // Finite values still load.
+  EXPECT_NEAR(LoadOdometryConfig(WriteTemp("e_ok.yaml", "extrinsic:\n  translation: [1, 2, 3]\n"))
+                  .T_imu_lidar.translation()
+                  .z(),
+              3.0, 1e-15);
+}
+
 TEST(OdometryConfig, KnotsPerScan) {
   EXPECT_EQ(OdometryConfig().knots_per_scan, 1);
   EXPECT_EQ(

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/point_layout_check.h"
 #include "raw_cloud.h"
 
 namespace ctlio::io::detail {
@@ -288,10 +289,10 @@ RawCloud ReadPcdRaw(const std::string& path) {
     ReadAsciiData(path, bytes, pos, h.data_line, &c);
   } else if (h.data_kind == "binary") {
     const size_t available = bytes.size() - pos, expected = c.points * c.point_step;
-    if (available < expected || !ZeroPadding(bytes, pos + expected)) {
-      Fail(path, "binary data holds " + std::to_string(available) +
-                     " B, POINTS × record = " + std::to_string(expected) + " B");
-    }
+    // Zero padding after the records (PCL's writer) is not data; anything else is.
+    const size_t data_bytes =
+        ZeroPadding(bytes, pos + expected) ? std::min(available, expected) : available;
+    CheckPointBytes(PackedBlock(c.points, c.point_step), data_bytes, path + ": ", "binary data");
     c.data.assign(bytes.begin() + pos, bytes.begin() + pos + expected);
   } else {
     ReadCompressedData(path, bytes, pos, &c);

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/io/point_layout_check.h"
 #include "raw_cloud.h"
 
 namespace ctlio::io::detail {
@@ -143,11 +144,10 @@ RawCloud ReadPlyRaw(const std::string& path) {
   const size_t available = bytes.size() - pos, expected = c.points * c.point_step;
   const bool rest_zero = std::all_of(bytes.begin() + std::min(pos + expected, bytes.size()),
                                      bytes.end(), [](char b) { return b == 0; });
-  if (available < expected || (only_vertex && !rest_zero)) {
-    Fail(path, "binary vertex data holds " + std::to_string(available) + " B, " +
-                   std::to_string(c.points) + " vertices × " + std::to_string(c.point_step) +
-                   " B = " + std::to_string(expected) + " B");
-  }
+  // After the vertices: other elements (never read), or zero padding when vertex is the only one.
+  const size_t data_bytes = (only_vertex && !rest_zero) ? available : std::min(available, expected);
+  CheckPointBytes(PackedBlock(c.points, c.point_step), data_bytes, path + ": ",
+                  "binary vertex data");
   c.data.assign(bytes.begin() + pos, bytes.begin() + pos + expected);
   if (format == "binary_big_endian") {
     for (size_t i = 0; i < c.points; ++i) {

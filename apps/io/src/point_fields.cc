@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ctlio/io/point_layout_check.h"
+
 namespace ctlio::io {
 namespace {
 
@@ -171,11 +173,12 @@ PointLayout DetectPointLayout(const std::vector<PointField>& fields, uint32_t po
   auto fail = [&](const std::string& what) { throw std::runtime_error(where + what + found); };
   PointLayout layout;
   layout.point_step = point_step;
-  for (const PointField& f : fields) {
-    if (FieldDatatypeSize(f.datatype) == 0) fail("field '" + f.name + "' has an unknown datatype");
-    if (point_step > 0 && f.offset + FieldDatatypeSize(f.datatype) * f.count > point_step) {
-      fail("field '" + f.name + "' ends past the point step of " + std::to_string(point_step) +
-           " B");
+  if (point_step > 0) {
+    CheckPointFields(fields, point_step, where);  // the geometry check every layout shares
+  } else {
+    for (const PointField& f : fields) {
+      if (FieldDatatypeSize(f.datatype) == 0)
+        fail("field '" + f.name + "' has an unknown datatype");
     }
   }
   auto coordinate = [&](const char* name, PointField* out) {

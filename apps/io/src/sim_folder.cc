@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/checked_output.h"
+#include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 
@@ -76,14 +77,9 @@ SE3 ReadPose(const YAML::Node& node, const std::string& what) {
   const auto t = node["translation"].as<std::vector<double>>();
   const auto q = node["quaternion_xyzw"].as<std::vector<double>>();
   if (t.size() != 3 || q.size() != 4) throw std::runtime_error(what + ": wrong sizes");
-  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-  const Vec3 r(t[0], t[1], t[2]);
-  // A zero (or non-unit) quaternion is no rotation: Eigen would silently give identity.
-  if (!r.allFinite() || !(std::abs(quat.norm() - 1.0) <= 1e-3)) {
-    throw std::runtime_error(what + ": translation not finite or quaternion norm " +
-                             std::to_string(quat.norm()) + " is not 1");
-  }
-  return SE3(quat.normalized(), r);
+  // A zero (or non-unit, or NaN) quaternion is no rotation: Eigen would silently give identity.
+  // The check every reader of an extrinsic shares (extrinsic_check.h).
+  return CheckedExtrinsic(q[3], q[0], q[1], q[2], Vec3(t[0], t[1], t[2]), what + ": ");
 }
 
 void EmitPose(YAML::Emitter& y, const std::string& key, const SE3& T) {

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -21,6 +22,24 @@ Setter SetVec6(Vec6* field) {
   return [field](const YAML::Node& v) {
     if (!v.IsSequence() || v.size() != 6) throw YAML::Exception(v.Mark(), "need 6 numbers");
     for (int i = 0; i < 6; ++i) (*field)[i] = v[i].as<double>();
+  };
+}
+
+// `set`, then every number of the (scalar or sequence) value must be finite: an extrinsic with a
+// NaN passes the rotation check below (NaN compares false) and gives a NaN trajectory, an Inf one
+// an Inf translation. The error names the file and the line of the offending number.
+Setter FiniteExtrinsic(const std::string& source, const std::string& key, Setter set) {
+  return [source, key, set](const YAML::Node& v) {
+    set(v);  // the shape first: a wrong size stays "bad value"
+    const size_t n = v.IsSequence() ? v.size() : 1;
+    for (size_t i = 0; i < n; ++i) {
+      const YAML::Node e = v.IsSequence() ? v[i] : v;
+      if (!std::isfinite(e.as<double>())) {
+        throw std::runtime_error(YamlWhere(source, e.Mark()) + ": " + key + "[" +
+                                 std::to_string(i) + "] is " + e.Scalar() +
+                                 ": an extrinsic must be finite");
+      }
+    }
   };
 }
 
@@ -213,13 +232,16 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,
-                  {{"xyz_rpy", SetVec6(&top->extrinsic_xyz_rpy)},
-                   {"rotation", SetFromYaml(&top->extrinsic_rotation)},
-                   {"translation", [top](const YAML::Node& n) {
+                  {{"xyz_rpy",
+                    FiniteExtrinsic(source, "extrinsic.xyz_rpy", SetVec6(&top->extrinsic_xyz_rpy))},
+                   {"rotation", FiniteExtrinsic(source, "extrinsic.rotation",
+                                                SetFromYaml(&top->extrinsic_rotation))},
+                   {"translation",
+                    FiniteExtrinsic(source, "extrinsic.translation", [top](const YAML::Node& n) {
                       const auto t = n.as<std::vector<double>>();
                       if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
                       top->extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
-                    }}});
+                    })}});
     } else if (key == "degeneracy") {
       ReadSection(v, section, source,
                   {{"enabled", SetFromYaml(&c->degeneracy.enabled)},
@@ -330,13 +352,15 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
       Vec6 xyz_rpy = Vec6::Zero();
       OdometryConfig::ImuSensor sensor;
       ReadSection(top.imus[j], section, source,
-                  {{"xyz_rpy", SetVec6(&xyz_rpy)},
-                   {"translation",
-                    [&xyz_rpy](const YAML::Node& n) {
-                      const auto t = n.as<std::vector<double>>();
-                      if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
-                      xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
-                    }},
+                  {{"xyz_rpy", FiniteExtrinsic(source, section + ".xyz_rpy", SetVec6(&xyz_rpy))},
+                   {"translation", FiniteExtrinsic(source, section + ".translation",
+                                                   [&xyz_rpy](const YAML::Node& n) {
+                                                     const auto t = n.as<std::vector<double>>();
+                                                     if (t.size() != 3)
+                                                       throw YAML::Exception(n.Mark(),
+                                                                             "need 3 numbers");
+                                                     xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
+                                                   })},
                    {"accel_variance", SetFromYaml(&sensor.accel_variance)},
                    {"gyro_variance", SetFromYaml(&sensor.gyro_variance)}});
       const Vec3 rpy = xyz_rpy.tail<3>();

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "ctlio/io/point_layout_check.h"
+
 namespace ctlio::io {
 
 std::vector<PointField> FieldsOf(const sensor_msgs::PointCloud2& msg) {
@@ -14,19 +16,18 @@ std::vector<PointField> FieldsOf(const sensor_msgs::PointCloud2& msg) {
 PointCloud DecodePointCloud2(const sensor_msgs::PointCloud2& msg, const TimeFieldOptions& options,
                              const std::string& where, PointLayout* layout_out) {
   if (msg.is_bigendian) throw std::runtime_error(where + "big-endian point data is not supported");
+  // Sizes first (point_layout_check.h): nothing below reads or reserves more than `data` holds.
+  PointBlock block;
+  block.width = msg.width;
+  block.height = msg.height;
+  block.point_step = msg.point_step;
+  block.row_step = msg.row_step;
+  CheckPointBytes(block, msg.data.size(), where);
   const PointLayout layout = DetectPointLayout(FieldsOf(msg), msg.point_step, options, where);
-  const size_t row_bytes = size_t(msg.width) * msg.point_step;
-  if (msg.height > 0 && msg.width > 0 &&
-      (msg.row_step < row_bytes ||
-       msg.data.size() < size_t(msg.height - 1) * msg.row_step + row_bytes)) {
-    throw std::runtime_error(where + "data holds " + std::to_string(msg.data.size()) + " B for " +
-                             std::to_string(msg.height) + " × " + std::to_string(msg.width) +
-                             " points of " + std::to_string(msg.point_step) + " B (row_step " +
-                             std::to_string(msg.row_step) + ")");
-  }
   PointCloud cloud;
   cloud.stamp_ns = int64_t(msg.header.stamp.toNSec());
-  for (uint32_t r = 0; r < msg.height; ++r) {
+  // (A zero width over 4e9 empty rows would otherwise spin through them.)
+  for (uint32_t r = 0; msg.width > 0 && r < msg.height; ++r) {
     DecodePoints(msg.data.data() + size_t(r) * msg.row_step, msg.width, layout, cloud.stamp_ns,
                  where, &cloud);
   }

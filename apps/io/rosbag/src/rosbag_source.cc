@@ -16,8 +16,10 @@
 #include <queue>
 
 #include "ctlio/io/bag_structure.h"
+#include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/pointcloud2.h"
+#include "ctlio/io/ros_wire_check.h"
 
 namespace ctlio::io {
 namespace {
@@ -28,10 +30,20 @@ constexpr char kImu[] = "sensor_msgs/Imu";
 // (the odometry then reports the IMU gap): bounds the memory when the IMU topic stops early.
 constexpr size_t kMaxPendingScans = 50;
 
-SE3 FromRos(const geometry_msgs::Quaternion& q, const geometry_msgs::Vector3& t) {
-  return SE3(Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix(),
-             Vec3(t.x, t.y, t.z));
-}
+// One /tf_static transform with where it was read (bag, topic, message index), checked when the
+// search below composes it (extrinsic_check.h): a NaN or zero quaternion on the path from the IMU
+// to the lidar is an error naming the message, one on an unrelated branch of the tree is not used.
+struct StaticEdge {
+  geometry_msgs::TransformStamped msg;
+  std::string where;
+  SE3 T() const {
+    const auto& q = msg.transform.rotation;
+    const auto& t = msg.transform.translation;
+    return CheckedExtrinsic(
+        q.w, q.x, q.y, q.z, Vec3(t.x, t.y, t.z),
+        where + "transform " + msg.header.frame_id + " → " + msg.child_frame_id + ": ");
+  }
+};
 SE3 FromRos(const geometry_msgs::Pose& p) {
   return SE3(Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
                  .normalized()
@@ -41,8 +53,8 @@ SE3 FromRos(const geometry_msgs::Pose& p) {
 
 // T_from_to over the static transform tree (edges parent → child hold T_parent_child), by a
 // breadth-first search that composes along the path; false if the frames are not connected.
-bool FindStaticTransform(const std::vector<geometry_msgs::TransformStamped>& edges,
-                         const std::string& from, const std::string& to, SE3* T) {
+bool FindStaticTransform(const std::vector<StaticEdge>& edges, const std::string& from,
+                         const std::string& to, SE3* T) {
   std::map<std::string, SE3> reached{{from, SE3()}};
   std::queue<std::string> open;
   open.push(from);
@@ -54,13 +66,13 @@ bool FindStaticTransform(const std::vector<geometry_msgs::TransformStamped>& edg
       *T = T_from_u;
       return true;
     }
-    for (const auto& e : edges) {
-      const SE3 T_pc = FromRos(e.transform.rotation, e.transform.translation);
+    for (const StaticEdge& edge : edges) {
+      const auto& e = edge.msg;
       if (e.header.frame_id == u && !reached.count(e.child_frame_id)) {
-        reached[e.child_frame_id] = T_from_u * T_pc;
+        reached[e.child_frame_id] = T_from_u * edge.T();
         open.push(e.child_frame_id);
       } else if (e.child_frame_id == u && !reached.count(e.header.frame_id)) {
-        reached[e.header.frame_id] = T_from_u * T_pc.Inverse();
+        reached[e.header.frame_id] = T_from_u * edge.T().Inverse();
         open.push(e.header.frame_id);
       }
     }
@@ -155,6 +167,10 @@ struct RosbagSource::Impl {
   std::vector<ImuSample> imu;  // samples not yet handed out
   int64_t last_imu_ns = INT64_MIN, last_scan_start_ns = INT64_MIN;
   size_t duplicates = 0;
+  size_t unusable_scans = 0;  // handed on empty or with their nominal interval (AddScan)
+  // Header stamps of the lidar messages: the last one and the last spacing (the scan period as
+  // the bag shows it, for the nominal interval of an unusable scan).
+  int64_t last_lidar_stamp_ns = INT64_MIN, last_lidar_spacing_ns = 0;
   uint64_t bytes = 0;
   double accel_norm_sum = 0.0;
   bool azimuth_logged = false;
@@ -213,20 +229,24 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     rosbag::View lidar(s.bag, rosbag::TopicQuery(s.lidar_topic));
     s.num_scans = lidar.size();
     if (lidar.begin() != lidar.end()) {
-      s.lidar_frame =
-          Instantiate<sensor_msgs::PointCloud2>(*lidar.begin(), path + ": ")->header.frame_id;
+      s.lidar_frame = ReadCheckedMessage<sensor_msgs::PointCloud2>(
+                          *lidar.begin(), s.Where(s.lidar_topic, 1), CheckPointCloud2Wire)
+                          .header.frame_id;
     }
     rosbag::View imu(s.bag, rosbag::TopicQuery(s.imu_topic));
     if (imu.begin() != imu.end()) {
       s.imu_frame = Instantiate<sensor_msgs::Imu>(*imu.begin(), path + ": ")->header.frame_id;
     }
     // Extrinsic: /tf_static, then the preset, then a shared frame (header comment).
-    std::vector<geometry_msgs::TransformStamped> edges;
+    std::vector<StaticEdge> edges;
     rosbag::View tf(s.bag, rosbag::TopicQuery("/tf_static"));
+    size_t tf_index = 0;
     for (const rosbag::MessageInstance& m : tf) {
-      if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
-        edges.insert(edges.end(), msg->transforms.begin(), msg->transforms.end());
-      }
+      ++tf_index;
+      if (!m.isType<tf2_msgs::TFMessage>()) continue;  // (a foreign type: not ours to read)
+      const std::string where = s.Where("/tf_static", tf_index);
+      const auto msg = ReadCheckedMessage<tf2_msgs::TFMessage>(m, where, CheckTfMessageWire);
+      for (const auto& t : msg.transforms) edges.push_back({t, where});
     }
     if (!s.lidar_frame.empty() && !s.imu_frame.empty() &&
         FindStaticTransform(edges, s.imu_frame, s.lidar_frame, &s.extrinsic)) {
@@ -265,6 +285,7 @@ size_t RosbagSource::NumScans() const { return impl_->num_scans; }
 const std::string& RosbagSource::lidar_topic() const { return impl_->lidar_topic; }
 const std::string& RosbagSource::imu_topic() const { return impl_->imu_topic; }
 uint64_t RosbagSource::bytes_read() const { return impl_->bytes; }
+size_t RosbagSource::unusable_scans() const { return impl_->unusable_scans; }
 
 SE3 RosbagSource::ImuFromLidar() const {
   if (impl_->extrinsic_origin.empty()) {
@@ -329,7 +350,6 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
 }
 
 void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
-  ++lidar_messages;
   const std::string where = Where(lidar_topic, lidar_messages);
   ScanFrame f;
   PointLayout layout;
@@ -349,11 +369,39 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
   // A stamp at the scan start is the start (DataSource: start_ns = the scan stamp) even when the
   // first returns were dropped; otherwise the earliest point is.
   const int64_t stamp = f.cloud.stamp_ns;
+  if (last_lidar_stamp_ns != INT64_MIN && stamp > last_lidar_stamp_ns) {
+    last_lidar_spacing_ns = stamp - last_lidar_stamp_ns;  // no overflow: both are ≥ 0 (ros::Time)
+  }
+  last_lidar_stamp_ns = stamp;
   f.start_ns = f.end_ns = stamp;
   if (f.cloud.has_times() && !f.cloud.points.empty()) {
     const auto [lo, hi] = std::minmax_element(f.cloud.times_ns.begin(), f.cloud.times_ns.end());
     f.start_ns = layout.convention.stamp_at == StampAt::kScanStart ? std::min(stamp, *lo) : *lo;
     f.end_ns = *hi;
+  }
+  if (f.end_ns <= f.start_ns) {
+    // Recovery, as in the folder readers (README "Bad input"): a cloud without usable points
+    // (empty, all non-finite) or with every point at one instant gives no interval; it is handed on
+    // with its nominal one (one scan period from the stamp, or up to it for a stamp at the scan
+    // end; the period is the last stamp spacing, so that the interval ends before the next scan,
+    // else scan_period_ns) and the odometry reports it degenerate when it has no points.
+    const int64_t period = std::max<int64_t>(
+        last_lidar_spacing_ns > 0 ? last_lidar_spacing_ns : options.time.scan_period_ns, 2);
+    const bool at_end = layout.convention.stamp_at == StampAt::kScanEnd;
+    int64_t lo = stamp, hi = stamp;
+    const bool overflow = at_end ? __builtin_sub_overflow(stamp, period - 1, &lo)
+                                 : __builtin_add_overflow(stamp, period - 1, &hi);
+    if (overflow) {
+      throw std::runtime_error(where + "stamp " + std::to_string(stamp) +
+                               " ns leaves no room for a scan period");
+    }
+    ++unusable_scans;
+    LOG(WARNING) << where << f.cloud.size() << " usable points (" << f.cloud.dropped_non_finite
+                 << " non-finite), " << (f.cloud.points.empty() ? "none" : "all at one instant")
+                 << ": handed on with its nominal interval [" << FormatSecondsNs(lo) << ", "
+                 << FormatSecondsNs(hi) << "] s (unusable scan " << unusable_scans << ")";
+    f.start_ns = lo;
+    f.end_ns = hi;
   }
   f.cloud.stamp_ns = f.start_ns;
   if (f.start_ns < last_scan_start_ns) {
@@ -364,18 +412,24 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
 }
 
 void RosbagSource::Impl::ReadOne() {
+  std::string where = path + ": ";
   try {
     const rosbag::MessageInstance& m = *it;
     bytes += m.size();
+    // `where` names the message being read (AddImu advances the IMU count itself), so that a
+    // library error names it too, never the one after it.
     if (m.getTopic() == imu_topic) {
-      AddImu(*Instantiate<sensor_msgs::Imu>(m, Where(imu_topic, imu_messages + 1)));
+      where = Where(imu_topic, imu_messages + 1);
+      AddImu(ReadCheckedMessage<sensor_msgs::Imu>(m, where, nullptr));
     } else {
-      AddScan(*Instantiate<sensor_msgs::PointCloud2>(m, Where(lidar_topic, lidar_messages + 1)));
+      where = Where(lidar_topic, ++lidar_messages);
+      AddScan(ReadCheckedMessage<sensor_msgs::PointCloud2>(m, where, CheckPointCloud2Wire));
     }
     ++it;
     exhausted = it == view->end();
   } catch (const ros::Exception& e) {
-    Fail(std::string("cannot read a message (truncated or corrupted bag?): ") + e.what());
+    throw std::runtime_error(where +
+                             "cannot read the message (truncated or corrupted bag?): " + e.what());
   }
 }
 
@@ -390,6 +444,11 @@ bool RosbagSource::Next(ScanFrame* frame) {
   if (s.pending.empty()) {
     if (s.duplicates > 0) {
       LOG(WARNING) << s.path << ": dropped " << s.duplicates << " duplicate IMU sample(s)";
+    }
+    if (s.unusable_scans > 0) {
+      LOG(WARNING) << s.path << ": " << s.lidar_topic << ": " << s.unusable_scans
+                   << " unusable scan(s) (empty, all non-finite or all at one instant) handed on "
+                   << "with their nominal interval";
     }
     return false;
   }

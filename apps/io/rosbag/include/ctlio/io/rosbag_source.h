@@ -72,6 +72,9 @@ class RosbagSource : public DataSource {
   const std::string& imu_topic() const;
   // Bytes of message data read so far (for throughput reports).
   uint64_t bytes_read() const;
+  // Scans read so far that had no usable points or no time spread (empty, all non-finite, all at
+  // one instant): each is handed on with its nominal interval, warned about and counted here.
+  size_t unusable_scans() const;
 
  private:
   struct Impl;
