@@ -99,6 +99,9 @@ TEST(ImuMeasurement, BodyCentricModelMissesExactlyOmegaCrossV) {
     const Vec3 omega_cross_v = (-c.w.tail<3>()).cross(-c.w.head<3>());
     EXPECT_GT(omega_cross_v.norm(), 0.1);
     EXPECT_LT((Evaluate(paper, blocks.Accel()) - S * omega_cross_v).norm(), 1e-8);
+    // The default model is the exact one (the paper's is chosen explicitly).
+    const ImuAccelMeasurement by_default(Singer(), t_k, t_k1, tau, f, cov);
+    EXPECT_LT(Evaluate(by_default, blocks.Accel()).norm(), 1e-8);
   }
 }
 

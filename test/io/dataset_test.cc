@@ -250,6 +250,11 @@ TEST(BadInput, MissingFoldersAndFiles) {
   ExpectError([&] { NewerCollegeReader r(d.string()); }, {"data.csv", "not found"});
   const fs::path e = TempDir("not_a_dataset");
   ExpectError([&] { OpenDataset(e.string()); }, {"not a dataset folder"});
+  // A file, with no file opener registered (this test does not link ctlio::io_rosbag): the error
+  // names the library that opens bags.
+  const fs::path f = e / "x.bag";
+  std::ofstream(f) << "#ROSBAG V2.0\n";
+  ExpectError([&] { OpenDataset(f.string()); }, {"x.bag", "not a dataset folder", "io_rosbag"});
 }
 
 TEST(BadInput, MalformedCsvLinesNameFileAndLine) {

@@ -90,6 +90,23 @@ TEST(Rosbag, SimulatorRoundTripThroughABag) {
   }
 }
 
+// Linking ctlio::io_rosbag is enough for OpenDataset to open a bag (dataset_file_opener.cc), as
+// ctlio_odometry does without --format; a file that is not a bag gets the bag reader's error.
+TEST(Rosbag, OpenDatasetOpensABag) {
+  const fs::path d = testing::FreshTempDir("rosbag_open_dataset");
+  const std::string bag = (d / "sim.bag").string();
+  sim::SimulatedSource written(SmallSim());
+  const size_t n = WriteRosbag(written, bag);
+  const std::unique_ptr<DataSource> read = OpenDataset(bag);
+  EXPECT_EQ(read->Name(), "rosbag:" + bag);
+  EXPECT_EQ(read->NumScans(), n);
+  EXPECT_THAT(read->ExtrinsicOrigin(), HasSubstr("/tf_static"));
+  EXPECT_EQ(ReadAll(*read).size(), n);
+  const std::string text = (d / "notes.txt").string();
+  std::ofstream(text) << "not a bag\n";
+  ExpectError([&] { OpenDataset(text); }, {"notes.txt", "not a ROS 1 bag"});
+}
+
 TEST(Rosbag, EveryDriverTimeFieldRoundTripsThroughPointCloud2) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-20.0, 20.0);

@@ -16,6 +16,15 @@ std::string WriteTemp(const std::string& name, const std::string& text) {
   return path;
 }
 
+TEST(OdometryConfig, DefaultAccelerometerModelIsTheExactOne) {
+  // The paper's body-centric model (false) is chosen explicitly; an empty config keeps the exact
+  // specific force.
+  EXPECT_TRUE(OdometryConfig().exact_specific_force);
+  EXPECT_TRUE(LoadOdometryConfig(WriteTemp("empty_imu.yaml", "imu: {}\n")).exact_specific_force);
+  EXPECT_FALSE(LoadOdometryConfig(WriteTemp("paper.yaml", "imu:\n  exact_specific_force: false\n"))
+                   .exact_specific_force);
+}
+
 TEST(OdometryConfig, ShippedConfigsLoad) {
   const OdometryConfig sim =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");

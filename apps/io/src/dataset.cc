@@ -184,20 +184,37 @@ std::string FormatSecondsNs(int64_t ns) {
   return buf;
 }
 
-std::unique_ptr<DataSource> OpenDataset(const std::string& folder, int64_t max_imu_gap_error_ns) {
+namespace {
+DatasetFileOpener& FileOpener() {
+  static DatasetFileOpener opener = nullptr;
+  return opener;
+}
+}  // namespace
+
+void RegisterDatasetFileOpener(DatasetFileOpener opener) { FileOpener() = opener; }
+
+std::unique_ptr<DataSource> OpenDataset(const std::string& path, int64_t max_imu_gap_error_ns) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::is_directory(folder, ec)) throw std::runtime_error(folder + ": folder not found");
-  if (fs::exists(fs::path(folder) / "ctlio_sim.yaml")) {
-    return std::make_unique<SimFolderReader>(folder, max_imu_gap_error_ns);
+  if (fs::is_regular_file(path, ec)) {
+    if (FileOpener() != nullptr) return FileOpener()(path, max_imu_gap_error_ns);
+    throw std::runtime_error(path +
+                             ": a file, not a dataset folder (ROS 1 bags are opened when "
+                             "ctlio::io_rosbag is linked)");
   }
-  if (fs::is_directory(fs::path(folder) / "raw_format")) {
+  if (!fs::is_directory(path, ec)) {
+    throw std::runtime_error(path + ": dataset folder or bag not found");
+  }
+  if (fs::exists(fs::path(path) / "ctlio_sim.yaml")) {
+    return std::make_unique<SimFolderReader>(path, max_imu_gap_error_ns);
+  }
+  if (fs::is_directory(fs::path(path) / "raw_format")) {
     NewerCollegeOptions options;
     options.max_imu_gap_error_ns = max_imu_gap_error_ns;
-    return std::make_unique<NewerCollegeReader>(folder, options);
+    return std::make_unique<NewerCollegeReader>(path, options);
   }
-  if (fs::is_directory(fs::path(folder) / "velodyne")) return std::make_unique<KittiReader>(folder);
-  throw std::runtime_error(folder +
+  if (fs::is_directory(fs::path(path) / "velodyne")) return std::make_unique<KittiReader>(path);
+  throw std::runtime_error(path +
                            ": not a dataset folder (no ctlio_sim.yaml, raw_format/ or velodyne/)");
 }
 

@@ -121,10 +121,18 @@ bool SecondsToNs(double s, int64_t* ns);
 // sec·10⁹ + nsec with 0 ≤ nsec < 10⁹ and no overflow; false otherwise.
 bool SecNsecToNs(int64_t sec, int64_t nsec, int64_t* ns);
 
-// Opens any supported dataset folder by looking at its contents: Newer College 2020
-// (raw_format/), ctlio simulator (ctlio_sim.yaml) or KITTI (velodyne/). Throws if none matches.
+// Opens any supported dataset by looking at it: a folder of Newer College 2020 (raw_format/),
+// ctlio's simulator (ctlio_sim.yaml) or KITTI (velodyne/), or a file handed to the registered
+// file opener (a ROS 1 bag, with ctlio::io_rosbag linked: rosbag_source.h, topics and extrinsic
+// found as ctlio_odometry finds them without flags). Throws naming `path` if none matches.
 // `max_imu_gap_error_ns`: the readers' opt-in IMU gap error (0 = gaps are warnings).
-std::unique_ptr<DataSource> OpenDataset(const std::string& folder,
-                                        int64_t max_imu_gap_error_ns = 0);
+std::unique_ptr<DataSource> OpenDataset(const std::string& path, int64_t max_imu_gap_error_ns = 0);
+
+// The reader OpenDataset hands a regular file to. ctlio::io keeps no ROS dependency, so the bag
+// reader lives in ctlio::io_rosbag, which registers itself here when it is linked (its link
+// interface forces the registering object in); programs never call this themselves.
+using DatasetFileOpener = std::unique_ptr<DataSource> (*)(const std::string& path,
+                                                          int64_t max_imu_gap_error_ns);
+void RegisterDatasetFileOpener(DatasetFileOpener opener);
 
 }  // namespace ctlio::io

@@ -27,7 +27,7 @@ class ImuAccelMeasurementWithTimeOffset final
   ImuAccelMeasurementWithTimeOffset(const gp::SingerModel<6>& model, double t_k, double t_k1,
                                     double stamp, const Vec3& accel, const Mat3& covariance,
                                     double gravity = 9.81,
-                                    AccelModel accel_model = AccelModel::kBodyCentric,
+                                    AccelModel accel_model = AccelModel::kSpecificForce,
                                     const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,

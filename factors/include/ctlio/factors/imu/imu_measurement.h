@@ -14,10 +14,11 @@
 // Gyro:  e_g = ω_m + ϖ_ω(τ) − b_g(τ)                        (ω = −ϖ_ω)
 // Accelerometer. The IMU reads f = C_rm(p̈ − g_m) = v̇_b + ω×v_b − C_rm g_m with
 // v_b = −ϖ_v, ω = −ϖ_ω (Ċ_rm = −ω^C_rm), i.e. f = −ϖ̇_v + ϖ_ω×ϖ_v − C_rm C_mi g_i:
-//   kBodyCentric  (the paper's model, no ω×v term):
-//                 e_a = f_m + ϖ̇_v(τ) + C_rm(τ) C_mi g_i − b_a(τ)
-//   kSpecificForce (exact):
+//   kSpecificForce (exact; the default):
 //                 e_a = f_m + ϖ̇_v(τ) − ϖ_ω(τ)×ϖ_v(τ) + C_rm(τ) C_mi g_i − b_a(τ)
+//   kBodyCentric  (the paper's approximation, no ω×v term; pass it explicitly to reproduce
+//                 the paper):
+//                 e_a = f_m + ϖ̇_v(τ) + C_rm(τ) C_mi g_i − b_a(τ)
 // With a mounting (rigid-body kinematics, imu_mounting.h; ω = −ϖ_ω, ω̇ = −ϖ̇_ω):
 //   e_g = ω_m + C_ir ϖ_ω(τ) − b_g(τ)
 //   e_a = f_m + C_ir [ϖ̇_v + C_rm C_mi g_i (− ϖ_ω×ϖ_v) − p×ϖ̇_ω − ϖ_ω×(ϖ_ω×p)] − b_a
@@ -93,13 +94,13 @@ class ImuAccelMeasurement final : public ceres::SizedCostFunction<3, 7, 6, 6, 7,
   // accel: f_m (m/s²) at time tau; covariance of one sample; gravity: |g|.
   ImuAccelMeasurement(const gp::SingerModel<6>& model, double t_k, double t_k1, double tau,
                       const Vec3& accel, const Mat3& covariance, double gravity = 9.81,
-                      AccelModel accel_model = AccelModel::kBodyCentric,
+                      AccelModel accel_model = AccelModel::kSpecificForce,
                       const ImuMounting& mounting = ImuMounting());
   // At the time of `state`, which this factor may share with the sample's gyro factor (adds the
   // rows it reads to `state`).
   ImuAccelMeasurement(std::shared_ptr<gp::SharedStateInterpolation> state, const Vec3& accel,
                       const Mat3& covariance, double gravity = 9.81,
-                      AccelModel accel_model = AccelModel::kBodyCentric,
+                      AccelModel accel_model = AccelModel::kSpecificForce,
                       const ImuMounting& mounting = ImuMounting());
 
   bool Evaluate(double const* const* parameters, double* residuals,

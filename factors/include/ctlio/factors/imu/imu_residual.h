@@ -18,9 +18,12 @@
 
 namespace ctlio::imu {
 
+// The accelerometer model (imu_measurement.h, SPEC §3). kSpecificForce, what an accelerometer
+// measures, is the library's default; kBodyCentric is the paper's approximation, selectable for
+// reproducing it (it leaves out ω×v, ~|ω||v| m/s² of systematic error in turns).
 enum class AccelModel {
-  kBodyCentric,    // the paper's: ϖ̇_v as the body acceleration, no ω×v
-  kSpecificForce,  // exact specific force, with ω×v
+  kBodyCentric,    // the paper's approximation: ϖ̇_v as the body acceleration, no ω×v
+  kSpecificForce,  // exact specific force, with ω×v (the default)
 };
 
 // S with SᵀS = Σ⁻¹ (S = L⁻¹, Σ = LLᵀ); throws std::invalid_argument if Σ is

@@ -57,8 +57,9 @@ struct OdometryConfig {
   double initial_bias_accel_variance = 0.1;
   double initial_bias_gyro_variance = 0.01;
   double gravity = 9.81599;
-  // Exact specific force (with ω×v) instead of the paper's body-centric accelerometer model.
-  bool exact_specific_force = false;
+  // Exact specific force (with ω×v; the default) or, false, the paper's approximation (the
+  // body-centric accelerometer model without ω×v, imu::AccelModel::kBodyCentric).
+  bool exact_specific_force = true;
   // IMU-input baseline: per-sample standard deviations of the IMU at imu_rate_hint; the
   // preintegration uses the continuous densities σ/√rate.
   double input_accel_sigma = 0.02;  // m/s², per sample at rate_hint
