@@ -3,11 +3,11 @@
 #   scripts/test.sh [BUILD_DIR]       (default: build-test)
 # The suite is built with clang++ (installed by install_deps.sh): on this code base it compiles in
 # ~0.7x GCC's CPU time (Eigen/Ceres template instantiation), which keeps CI inside its budget.
-# CTLIO_CXX=g++ builds it with GCC instead (scripts/run_main.sh and a plain cmake use the default
-# compiler, GCC on Debian, so both compilers stay exercised).
+# CTLIO_CXX=g++ builds it with GCC instead (a plain cmake uses the default compiler, GCC on
+# Debian; the sanitized suite and CI's ThreadSanitizer pass use GCC).
 # CTLIO_SANITIZE=1 builds with AddressSanitizer + UndefinedBehaviorSanitizer (GCC by default).
 # CTLIO_BUILD_BENCHMARKS=OFF skips the Google Benchmark programs (they are not tests; CI skips them
-# to stay inside its time budget, the main job's build still compiles them).
+# to stay inside its time budget).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${1:-build-test}
