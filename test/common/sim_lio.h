@@ -34,6 +34,16 @@ inline lio::OdometryConfig SimLioConfig() {
   return config;
 }
 
+// A short sparse sequence for pipeline tests: 1 s of medium motion (index 0), 16 beams, every 8th
+// firing: enough scans to fill and slide the window in a second or two of test time.
+inline sim::SimConfig ShortSparseSequence() {
+  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
+  c.duration_s = 1.0;
+  c.lidar.beams = 16;
+  c.lidar.firing_decimation = 8;
+  return c;
+}
+
 // Tuning sequence `regime`/100 (not one of the reported indices 0–9 of docs/experiments) for
 // `duration_s`, reduced lidar (16 beams, every 4th firing), with the calibration the tests start
 // wrong from: a nominal extrinsic 3° / 10 cm off the truth (axis and direction drawn for index 100)

@@ -23,13 +23,7 @@
 namespace ctlio::lio {
 namespace {
 
-sim::SimConfig ShortSequence() {
-  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
-  c.duration_s = 1.0;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 8;
-  return c;
-}
+sim::SimConfig ShortSequence() { return testing::ShortSparseSequence(); }
 
 TEST(FinalTrajectory, PassesThroughTheFinalStatesContinuously) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {

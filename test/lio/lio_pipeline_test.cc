@@ -18,13 +18,7 @@
 namespace ctlio::lio {
 namespace {
 
-sim::SimConfig ShortSequence() {
-  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
-  c.duration_s = 1.0;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 8;
-  return c;
-}
+sim::SimConfig ShortSequence() { return testing::ShortSparseSequence(); }
 
 OdometryConfig Config(LioMethod method) {
   OdometryConfig c = testing::SimLioConfig();
