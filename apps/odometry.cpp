@@ -426,8 +426,9 @@ int main(int argc, char** argv) {
                 "T_world_lidar at every scan end (TUM: t x y z qx qy qz qw)");
       if (!run.dense.empty()) {
         io::WriteTum(out + "/trajectory_dense.tum", run.dense);
-        files.Add(out + "/trajectory_dense.tum",
-                  "the continuous-time estimate at --trajectory_rate from the final estimates (TUM)");
+        files.Add(
+            out + "/trajectory_dense.tum",
+            "the continuous-time estimate at --trajectory_rate from the final estimates (TUM)");
       }
       if (!run.dense_live.empty()) {
         io::WriteTum(out + "/trajectory_dense_live.tum", run.dense_live);
