@@ -13,6 +13,7 @@
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/text_table.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 
@@ -80,6 +81,7 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   std::vector<ImuSample> kept;
   kept.reserve(imu->size());
   size_t duplicates = 0;
+  WarningLimiter limiter(path);  // the first few of each kind in full, then totals
   for (size_t i = 0; i < imu->size(); ++i) {
     const ImuSample& s = (*imu)[i];
     const int line = i < lines.size() ? lines[i] : 0;
@@ -87,8 +89,10 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
       const int64_t prev = kept.back().t_ns;
       if (s.t_ns == prev) {
         ++duplicates;
-        LOG(WARNING) << path << ":" << line << ": duplicate IMU time " << s.t_ns
-                     << " ns, sample dropped";
+        if (limiter.Count("duplicate IMU time")) {
+          LOG(WARNING) << path << ":" << line << ": duplicate IMU time " << s.t_ns
+                       << " ns, sample dropped";
+        }
         continue;
       }
       if (s.t_ns < prev) {
@@ -116,16 +120,15 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   std::vector<int64_t> sorted = dt;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const int64_t median = sorted[sorted.size() / 2];
-  size_t gaps = 0;
   for (size_t i = 0; i < dt.size(); ++i) {
     if (dt[i] <= 3 * median) continue;
-    if (++gaps <= 10) {
+    if (limiter.Count("IMU gap")) {
       LOG(WARNING) << path << ":" << (i + 1 < lines.size() ? lines[i + 1] : 0) << ": gap of "
                    << 1e-9 * double(dt[i]) << " s in the IMU (median spacing "
                    << 1e-9 * double(median) << " s); samples handed on";
     }
   }
-  if (gaps > 10) LOG(WARNING) << path << ": " << gaps << " IMU gaps in all";
+  limiter.LogTotals();
 }
 
 bool ParseSecondsNs(const std::string& s, int64_t* ns) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/checked_output.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/text_table.h"
 
 namespace ctlio::io {
@@ -30,12 +31,9 @@ void RequireDir(const fs::path& p) {
 SE3 PoseFromRow(const std::string& path, const TableRow& row, size_t first) {
   const Vec3 r(ToDouble(path, row, first), ToDouble(path, row, first + 1),
                ToDouble(path, row, first + 2));
-  const Eigen::Quaterniond q(ToDouble(path, row, first + 6), ToDouble(path, row, first + 3),
-                             ToDouble(path, row, first + 4), ToDouble(path, row, first + 5));
-  if (std::abs(q.norm() - 1.0) > 1e-3) {
-    FailAt(path, row.line, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
-  }
-  return SE3(q, r);
+  return CheckedGroundTruthPose(ToDouble(path, row, first + 6), ToDouble(path, row, first + 3),
+                                ToDouble(path, row, first + 4), ToDouble(path, row, first + 5), r,
+                                path + ":" + std::to_string(row.line) + ": ");
 }
 
 int64_t StampFromSecNsec(const std::string& path, const TableRow& row, size_t k) {

@@ -15,6 +15,7 @@
 
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/extrinsic_check.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 
@@ -213,10 +214,11 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       if (!ground_truth_.empty() && t <= ground_truth_.back().t_ns) {
         FailAt(gt_path, row.line, "ground-truth time not increasing");
       }
-      const Eigen::Quaterniond q(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
-                                 ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6));
-      if (std::abs(q.norm() - 1.0) > 1e-3) FailAt(gt_path, row.line, "quaternion norm is not 1");
-      ground_truth_.push_back({t, SE3(q, ToVec3(gt_path, row, 1))});
+      ground_truth_.push_back(
+          {t, CheckedGroundTruthPose(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
+                                     ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6),
+                                     ToVec3(gt_path, row, 1),
+                                     gt_path + ":" + std::to_string(row.line) + ": ")});
     }
   }
 }
