@@ -12,6 +12,7 @@
 #include <sensor_msgs/Imu.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -23,6 +24,7 @@
 #include "common/temp_dir.h"
 #include "ctlio/io/dataset.h"
 #include "ctlio/io/ground_truth_check.h"
+#include "ctlio/io/kitti.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/trajectory_io.h"
@@ -196,6 +198,32 @@ TEST(WarningLimiter, ManyImuGapsInABagLogAFewLinesAndATotal) {
   }
   EXPECT_EQ(sink.CountContaining("s in the IMU; samples handed on"), WarningLimiter::kDefaultShown);
   EXPECT_EQ(sink.CountContaining("gaps.bag: 100 IMU gap warnings in all (the first 5 logged)"), 1u);
+}
+
+// A folder of 40 empty KITTI scans: each is handed on with its nominal interval, and the log has
+// the first 5 of those warnings and one total at the end of the sequence.
+TEST(WarningLimiter, ManyUnusableScansInAFolderLogAFewLinesAndATotal) {
+  const fs::path k = testing::FreshTempDir("limiter_kitti");
+  fs::create_directories(k / "velodyne");
+  std::ofstream times(k / "times.txt");
+  for (int i = 0; i < 40; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.bin", i);
+    std::ofstream(k / "velodyne" / name, std::ios::binary).flush();
+    times << 0.1 * i << "\n";
+  }
+  times.close();
+  WarningSink sink;
+  KittiReader reader(k.string());
+  ScanFrame f;
+  int frames = 0;
+  while (reader.Next(&f)) ++frames;
+  EXPECT_EQ(frames, 40);
+  EXPECT_EQ(sink.CountContaining("scan interval set to its nominal 0.1 s"),
+            WarningLimiter::kDefaultShown);
+  EXPECT_EQ(sink.CountContaining(": 40 scan without an interval warnings in all (the first 5 "
+                                 "logged)"),
+            1u);
 }
 
 TEST(WarningLimiter, CountsPerKindAndReportsTotalsOnce) {

@@ -53,7 +53,8 @@ void RequireFirstImuInBodyFrame(const DataSource& source, const std::string& tar
   }
 }
 
-size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c) {
+size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c,
+                         WarningLimiter* warnings) {
   if (!c->has_times()) return 0;
   size_t kept = 0;
   const size_t n = c->size();
@@ -66,9 +67,11 @@ size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, 
     ++kept;
   }
   if (kept == n) return 0;
-  LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
-               << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
-               << ", " << FormatSecondsNs(hi_ns) << "] s";
+  if (warnings == nullptr || warnings->Count("points outside the scan interval")) {
+    LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
+                 << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
+                 << ", " << FormatSecondsNs(hi_ns) << "] s";
+  }
   c->points.resize(kept);
   c->times_ns.resize(kept);
   if (c->intensity.size() == n) c->intensity.resize(kept);
