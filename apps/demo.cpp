@@ -4,6 +4,7 @@
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
+#include <iostream>
 #include <random>
 
 #include "common/command_line.h"
@@ -43,7 +44,12 @@ int main(int argc, char** argv) {
   ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
-  CHECK_GT(FLAGS_points, 2) << "--points must be at least 3";
+  try {
+    ctlio::apps::RequireInRange("points", FLAGS_points, 3, 10'000'000);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
 
   std::mt19937 rng(FLAGS_seed);
   std::normal_distribution<double> n;

@@ -277,6 +277,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    ctlio::apps::RequireInRange("max_iterations", FLAGS_max_iterations, 1, 100'000);
     return ctlio::euroc::Run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "euroc_fusion: %s\n", e.what());

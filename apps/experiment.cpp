@@ -40,6 +40,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <thread>
 #include <tuple>
 
@@ -503,6 +504,16 @@ int main(int argc, char** argv) {
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {
+    // Counts and rates, before any work (docs/user-guide/bad-input.md): a huge --threads used to
+    // abort inside thread creation.
+    using ctlio::apps::RequireInRange;
+    RequireInRange("threads", FLAGS_threads, 0, ctlio::apps::kMaxThreads, " (0 = number of cores)");
+    RequireInRange("sequences", FLAGS_sequences, 1, 100'000);
+    RequireInRange("first_sequence", FLAGS_first_sequence, 0, 1'000'000);
+    RequireInRange("duration", FLAGS_duration, 0.1, 3600.0, " s");
+    RequireInRange("beams", FLAGS_beams, 1, 4096);
+    RequireInRange("firing_decimation", FLAGS_firing_decimation, 1, 1'000'000);
+    RequireInRange("lidar_rate", FLAGS_lidar_rate, 0.1, 1000.0, " Hz");
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     if (!FLAGS_merge.empty()) {
       Merge();
@@ -627,7 +638,14 @@ int main(int argc, char** argv) {
       }
     };
     std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    try {
+      for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    } catch (const std::system_error& e) {
+      // Let the started workers finish the jobs; the message says why there are fewer.
+      std::fprintf(stderr, "warning: started %zu of %d threads (%s); running on those\n",
+                   pool.size(), threads, e.what());
+      if (pool.empty()) throw std::runtime_error(std::string("cannot start a thread: ") + e.what());
+    }
     for (auto& t : pool) t.join();
 
     std::vector<lioapp::RunRow> rows;

@@ -330,6 +330,17 @@ int main(int argc, char** argv) {
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   try {
+    // Counts and rates, before any work (docs/user-guide/bad-input.md).
+    using ctlio::apps::RequireInRange;
+    RequireInRange("frontend_threads", FLAGS_frontend_threads, 1, ctlio::apps::kMaxThreads);
+    RequireInRange("trajectory_rate", FLAGS_trajectory_rate, 0.0, 1e4, " Hz (0 = off)");
+    RequireInRange("play_rate", FLAGS_play_rate, 0.0, 1e6, " (0 = back to back)");
+    RequireInRange("max_imu_gap_error", FLAGS_max_imu_gap_error, 0.0, 1e6, " s (0 = off)");
+    RequireInRange("sim_index", FLAGS_sim_index, 0, 1'000'000);
+    RequireInRange("sim_duration", FLAGS_sim_duration, 0.1, 3600.0, " s");
+    RequireInRange("sim_beams", FLAGS_sim_beams, 1, 4096);
+    RequireInRange("sim_firing_decimation", FLAGS_sim_firing_decimation, 1, 1'000'000);
+    RequireInRange("sim_lidar_rate", FLAGS_sim_lidar_rate, 0.1, 1000.0, " Hz");
     const std::vector<std::string> methods = Split(FLAGS_method);
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
@@ -347,9 +358,6 @@ int main(int argc, char** argv) {
     const bool gap_flag = !gflags::GetCommandLineFlagInfoOrDie("max_imu_gap_error").is_default;
     if (FLAGS_out.empty()) throw std::runtime_error("--out is required");
     if (FLAGS_max_scans < 0) throw std::runtime_error("--max_scans must be >= 0 (0 = all)");
-    if (!(FLAGS_play_rate >= 0.0) || !std::isfinite(FLAGS_play_rate)) {
-      throw std::runtime_error("--play_rate must be a finite number >= 0 (0 = back to back)");
-    }
     if (!FLAGS_save_map.empty()) {  // before the run, not after an hour of it
       lioapp::CheckMapFlags(FLAGS_save_map, FLAGS_map_voxel_size, FLAGS_map_max_points);
     }
@@ -451,7 +459,10 @@ int main(int argc, char** argv) {
          << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin
          << "\"\nimu_samples_rejected " << run.imu_rejected << "\npoints_dropped_out_of_interval "
          << run.points_dropped << "\nscans_skipped " << run.scans_skipped << "\nconstant_imu_scans "
-         << run.constant_imu_scans << "\n";
+         << run.constant_imu_scans << "\nlidar_gaps " << run.lidar_gaps << "\n";
+      if (run.lidar_gaps > 0) ev << "first_lidar_gap \"" << run.first_lidar_gap << "\"\n";
+      // An estimate the lidar never fixed has no ATE; the line says why (run_checks.h).
+      if (!run.unregistered_run.empty()) ev << "no_ate \"" << run.unregistered_run << "\"\n";
       if (!run.first_input_warning.empty()) {
         ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
       }
@@ -629,6 +640,15 @@ int main(int argc, char** argv) {
             "with a frozen IMU (first: %s)\n",
             r.method.c_str(), r.imu_rejected, r.points_dropped, r.scans_skipped,
             r.constant_imu_scans, r.first_input_warning.c_str());
+      }
+    }
+    for (const auto& r : runs) {
+      if (!r.unregistered_run.empty()) {
+        std::printf("  %-10s FAILED, no ATE: %s\n", r.method.c_str(), r.unregistered_run.c_str());
+      }
+      if (r.lidar_gaps > 0) {
+        std::printf("  %-10s lidar: %d gap(s) over 3x the median scan period (first: %s)\n",
+                    r.method.c_str(), r.lidar_gaps, r.first_lidar_gap.c_str());
       }
     }
     std::printf("\n");

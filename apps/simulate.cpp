@@ -136,6 +136,20 @@ int main(int argc, char** argv) {
   }
   try {
     using namespace ctlio;
+    // Counts and rates, before any work (docs/user-guide/bad-input.md). Times are int64
+    // nanoseconds (±9.22e9 s); a ROS 1 bag's are uint32 seconds: the sequence must fit after
+    // --start_s (the duration is at most 3600 s).
+    using ctlio::apps::RequireInRange;
+    RequireInRange("index", FLAGS_index, 0, 1'000'000);
+    RequireInRange("pillars", FLAGS_pillars, 0, 10'000);
+    RequireInRange("imu_outage_rate", FLAGS_imu_outage_rate, 0.0, 100.0, " per second");
+    if (FLAGS_layout == "rosbag") {
+      RequireInRange("start_s", FLAGS_start_s, 0.0, 4.29e9,
+                     " s (a ROS 1 bag's times are unsigned 32-bit seconds)");
+    } else {
+      RequireInRange("start_s", FLAGS_start_s, -9.2e9, 9.2e9,
+                     " s (times are int64 nanoseconds, at most ±9.22e9 s)");
+    }
     const sim::Preset preset = sim::ParsePreset(FLAGS_preset);
     sim::SimOverrides given;
     if (auto r = Given("regime", FLAGS_regime)) given.regime = sim::ParseRegime(*r);

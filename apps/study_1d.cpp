@@ -125,6 +125,20 @@ constexpr char kUsage[] =
 int main(int argc, char** argv) {
   ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   try {
+    // Counts and rates, before any work (docs/user-guide/bad-input.md).
+    using ctlio::apps::RequireInRange;
+    RequireInRange("threads", FLAGS_threads, 1, ctlio::apps::kMaxThreads);
+    RequireInRange("validation", FLAGS_validation, 1, 10'000'000);
+    RequireInRange("input_validation", FLAGS_input_validation, 1, 10'000'000);
+    RequireInRange("test", FLAGS_test, 1, 10'000'000);
+    RequireInRange("extra_test", FLAGS_extra_test, 1, 10'000'000);
+    RequireInRange("min_rmse_subset", FLAGS_min_rmse_subset, 1, FLAGS_validation,
+                   " (at most --validation)");
+    RequireInRange("heterogeneous_checks", FLAGS_heterogeneous_checks, 0, 1'000'000);
+    RequireInRange("accel_rate", FLAGS_accel_rate, 1.0, 1e5, " Hz");
+    RequireInRange("position_rate", FLAGS_position_rate, 0.01, 1e4, " Hz");
+    RequireInRange("async_rate_a", FLAGS_async_rate_a, 1.0, 1e5, " Hz");
+    RequireInRange("async_rate_b", FLAGS_async_rate_b, 1.0, 1e5, " Hz");
     std::filesystem::create_directories(FLAGS_output_dir);
     StudyConfig base;
     base.sensors.duration_s = FLAGS_duration;

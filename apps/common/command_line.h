@@ -13,8 +13,12 @@
 
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <ostream>
+#include <sstream>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace ctlio::apps {
@@ -32,5 +36,26 @@ std::vector<gflags::CommandLineFlagInfo> OwnFlags();
 // The help of `flags`: one "--name=default  (type)" line each, the description wrapped below it at
 // 100 columns.
 void PrintFlags(const std::vector<gflags::CommandLineFlagInfo>& flags, std::ostream& os);
+
+// The largest thread count a flag or config key may ask for (window.threads and
+// lidar_frontend.threads have the same bound): far above the cores of any machine the programs run
+// on, far below the threads a process may create.
+inline constexpr int kMaxThreads = 256;
+
+// The start-up check of a count or rate flag: throws std::invalid_argument
+// "--<name>=<value> is out of range: must be in [lo, hi]<note>" unless lo <= value <= hi (NaN is
+// never in range). Programs call it for every count and rate flag before any work, so that a
+// huge --threads is an error naming the flag, not an abort inside thread creation, and a rate of
+// 1e300 Hz never sizes an allocation.
+template <typename T>
+void RequireInRange(const char* name, T value, T lo, T hi, const char* note = "") {
+  static_assert(std::is_arithmetic_v<T>, "a count or a rate");
+  if (lo <= value && value <= hi) return;  // false for NaN
+  std::ostringstream m;
+  m.precision(10);
+  m << "--" << name << '=' << value << " is out of range: must be in [" << lo << ", " << hi << ']'
+    << note;
+  throw std::invalid_argument(m.str());
+}
 
 }  // namespace ctlio::apps

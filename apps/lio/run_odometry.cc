@@ -19,6 +19,7 @@
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
+#include "run_checks.h"
 
 namespace ctlio::lioapp {
 
@@ -301,6 +302,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<double> ms;
   SE3 live_from_replay;  // identity until a calibration warm-up replay
   size_t done = 0;
+  std::vector<int64_t> scan_ends;  // of the scans handed to the odometry, for the lidar gaps
   std::optional<std::pair<std::chrono::steady_clock::time_point, int64_t>> pace_origin;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
     for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
@@ -326,6 +328,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     have_previous = true;
     previous_end = frame.end_ns;
+    scan_ends.push_back(frame.end_ns);
     ++done;
     ms.push_back(r.milliseconds);
     if (r.revised_scans > 0) {
@@ -412,8 +415,25 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     run.true_biases.push_back(info.true_bias);
     run.true_time_offsets.push_back(info.true_time_offset_s);
   }
+  // Whole-run checks (run_checks.h): no ATE of an estimate the lidar never fixed.
+  run.unregistered_run = UnregisteredRunReason(run.scans);
+  if (!run.unregistered_run.empty()) {
+    LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.unregistered_run;
+    run.ate.reset();
+    run.live_ate.reset();
+    run.drift_per_100m.reset();
+  }
+  const LidarGaps gaps = FindLidarGaps(scan_ends);
+  run.lidar_gaps = gaps.count;
+  run.first_lidar_gap = gaps.first;
+  if (gaps.count > 0) {
+    LOG(WARNING) << source.Name() << ": " << gaps.count << " lidar gap(s) (scans missing: a "
+                 << "spacing over 3x the median scan period), longest " << gaps.longest_s
+                 << " s; first: " << gaps.first;
+  }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
-                (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2;
+                (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2 ||
+                !run.unregistered_run.empty();
   return run;
 }
 

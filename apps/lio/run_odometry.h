@@ -118,8 +118,14 @@ struct RunSummary {
   bool extrinsic_estimated = false;
   Vec6 final_extrinsic_sigma = Vec6::Zero();
   std::optional<SE3> true_extrinsic;
-  // The run is a failure if a scan failed after initialisation or the ATE exceeds
-  // `failure_ate` (the estimate left the room of any sensible error).
+  // Whole-run checks (run_checks.h). A run in which the lidar registered no scan after the first
+  // is a failure without an ATE (`ate` and `live_ate` empty): why, here. Lidar gaps (scan ends
+  // spaced more than 3× the median) are a warning: their count and the first.
+  std::string unregistered_run;
+  int lidar_gaps = 0;
+  std::string first_lidar_gap;
+  // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`
+  // (the estimate left the room of any sensible error), or the lidar registered no scan.
   bool failure = false;
 };
 

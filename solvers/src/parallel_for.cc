@@ -6,6 +6,9 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
+#include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -44,7 +47,17 @@ class Pool {
     std::unique_lock<std::mutex> run(run_mutex_, std::try_to_lock);
     if (!run.owns_lock()) return false;
     while (helpers_.size() + 1 < chunks) {
-      helpers_.emplace_back([this] { HelperLoop(); });
+      try {
+        helpers_.emplace_back([this] { HelperLoop(); });
+      } catch (const std::system_error& e) {
+        // Thread creation failed (a thread limit, no memory for a stack): an error that says so,
+        // not an abort. The helpers started so far stay and serve later loops.
+        throw std::runtime_error("ParallelFor: cannot start helper thread " +
+                                 std::to_string(helpers_.size() + 1) + " of " +
+                                 std::to_string(chunks - 1) + " (" + e.what() +
+                                 "); ask for fewer threads (window.threads, "
+                                 "lidar_frontend.threads)");
+      }
     }
     task_ = &f;
     n_ = n;

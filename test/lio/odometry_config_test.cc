@@ -126,6 +126,52 @@ TEST(OdometryConfig, NonFiniteExtrinsicNamesFileAndLine) {
               3.0, 1e-15);
 }
 
+// Count keys out of range are errors naming the file, the line, the key and the range (a huge
+// window.threads used to abort inside thread creation); Validate has the same bounds for library
+// users.
+TEST(OdometryConfig, CountKeysOutOfRangeNameFileLineKeyAndRange) {
+  struct Case {
+    const char* name;
+    const char* text;
+    const char* needle;
+  };
+  const Case cases[] = {
+      {"t_huge.yaml", "window:\n  knots: 2\n  threads: 100000\n",
+       ":3: window.threads = 100000 is out of range: must be in [1, 256]"},
+      {"t_zero.yaml", "window:\n  threads: 0\n", ":2: window.threads = 0 is out of range"},
+      {"knots.yaml", "window:\n  knots: 1000000\n", ":2: window.knots = 1000000 is out of range"},
+      {"ft.yaml", "lidar_frontend:\n  threads: 65536\n",
+       ":2: lidar_frontend.threads = 65536 is out of range: must be in [1, 256]"},
+      {"ft_neg.yaml", "lidar_frontend:\n  threads: -4\n", ":2: lidar_frontend.threads = -4"},
+      {"voxel.yaml", "lidar_frontend:\n  voxel_size: 0.5\n  max_points_per_voxel: 2000000000\n",
+       ":3: lidar_frontend.max_points_per_voxel = 2000000000 is out of range: must be in [1, 10000]"},
+      {"neigh.yaml", "lidar_frontend:\n  max_neighbours: 99999\n",
+       ":2: lidar_frontend.max_neighbours = 99999 is out of range"},
+      {"per_method.yaml", "per_method:\n  imu_input:\n    window:\n      threads: 512\n",
+       ":4: per_method.imu_input.window.threads = 512 is out of range"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = WriteTemp(c.name, c.text);
+    try {
+      LoadOdometryConfig(path);
+      ADD_FAILURE() << c.name << ": no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + c.needle), std::string::npos) << e.what();
+    }
+  }
+  OdometryConfig config;
+  config.solver_threads = 257;
+  EXPECT_THROW(config.Validate(), std::invalid_argument);
+  config.solver_threads = 256;
+  config.frontend.threads = 1000;
+  EXPECT_THROW(config.Validate(), std::invalid_argument);
+  config.frontend.threads = 2;
+  config.frontend.max_points_per_voxel = 10001;
+  EXPECT_THROW(config.Validate(), std::invalid_argument);
+  config.frontend.max_points_per_voxel = 20;
+  EXPECT_NO_THROW(config.Validate());
+}
+
 TEST(OdometryConfig, KnotsPerScan) {
   EXPECT_EQ(OdometryConfig().knots_per_scan, 1);
   EXPECT_EQ(

@@ -5,8 +5,12 @@
 #include "ctlio/solvers/parallel_for.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
+#include <fstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -104,6 +108,33 @@ TEST(ParallelFor, NestedAndConcurrentLoopsRunOnTheirCallers) {
   }
   for (std::thread& c : callers) c.join();
   for (int t = 0; t < 4; ++t) EXPECT_EQ(totals[t], 500L * 499500L) << "caller " << t;
+}
+
+// Thread creation that fails (here: an address-space limit leaves no room for the helpers' stacks)
+// is a std::runtime_error naming the cause and the config keys, not an abort from an uncaught
+// std::system_error. In a child process, whose limit does not touch the other tests.
+[[noreturn]] void LoopUnderAnAddressSpaceLimit() {
+  size_t pages = 0;
+  std::ifstream("/proc/self/statm") >> pages;
+  const rlim_t now = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE));
+  const rlimit limit{now + (16u << 20), now + (16u << 20)};  // 16 MB: two 8 MB stacks at most
+  setrlimit(RLIMIT_AS, &limit);
+  try {
+    ParallelFor(4000, 4000, [](size_t, size_t, size_t) {});
+    std::fprintf(stderr, "no error\n");
+    _exit(1);
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    _exit(3);
+  }
+}
+
+TEST(ParallelFor, FailingThreadCreationIsAClearError) {
+  // A fresh process: the pool's helpers of the earlier tests are not forked along.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(LoopUnderAnAddressSpaceLimit(), ::testing::ExitedWithCode(3),
+              "ParallelFor: cannot start helper thread [0-9]+ of 3999 .*window.threads, "
+              "lidar_frontend.threads");
 }
 
 }  // namespace

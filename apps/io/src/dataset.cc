@@ -13,6 +13,7 @@
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/text_table.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 
@@ -52,7 +53,8 @@ void RequireFirstImuInBodyFrame(const DataSource& source, const std::string& tar
   }
 }
 
-size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c) {
+size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* c,
+                         WarningLimiter* warnings) {
   if (!c->has_times()) return 0;
   size_t kept = 0;
   const size_t n = c->size();
@@ -65,9 +67,11 @@ size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, 
     ++kept;
   }
   if (kept == n) return 0;
-  LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
-               << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
-               << ", " << FormatSecondsNs(hi_ns) << "] s";
+  if (warnings == nullptr || warnings->Count("points outside the scan interval")) {
+    LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
+                 << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
+                 << ", " << FormatSecondsNs(hi_ns) << "] s";
+  }
   c->points.resize(kept);
   c->times_ns.resize(kept);
   if (c->intensity.size() == n) c->intensity.resize(kept);
@@ -80,6 +84,7 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   std::vector<ImuSample> kept;
   kept.reserve(imu->size());
   size_t duplicates = 0;
+  WarningLimiter limiter(path);  // the first few of each kind in full, then totals
   for (size_t i = 0; i < imu->size(); ++i) {
     const ImuSample& s = (*imu)[i];
     const int line = i < lines.size() ? lines[i] : 0;
@@ -87,8 +92,10 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
       const int64_t prev = kept.back().t_ns;
       if (s.t_ns == prev) {
         ++duplicates;
-        LOG(WARNING) << path << ":" << line << ": duplicate IMU time " << s.t_ns
-                     << " ns, sample dropped";
+        if (limiter.Count("duplicate IMU time")) {
+          LOG(WARNING) << path << ":" << line << ": duplicate IMU time " << s.t_ns
+                       << " ns, sample dropped";
+        }
         continue;
       }
       if (s.t_ns < prev) {
@@ -116,16 +123,15 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   std::vector<int64_t> sorted = dt;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const int64_t median = sorted[sorted.size() / 2];
-  size_t gaps = 0;
   for (size_t i = 0; i < dt.size(); ++i) {
     if (dt[i] <= 3 * median) continue;
-    if (++gaps <= 10) {
+    if (limiter.Count("IMU gap")) {
       LOG(WARNING) << path << ":" << (i + 1 < lines.size() ? lines[i + 1] : 0) << ": gap of "
                    << 1e-9 * double(dt[i]) << " s in the IMU (median spacing "
                    << 1e-9 * double(median) << " s); samples handed on";
     }
   }
-  if (gaps > 10) LOG(WARNING) << path << ": " << gaps << " IMU gaps in all";
+  limiter.LogTotals();
 }
 
 bool ParseSecondsNs(const std::string& s, int64_t* ns) {

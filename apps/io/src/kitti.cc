@@ -10,6 +10,7 @@
 #include "ctlio/io/point_fields.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 namespace fs = std::filesystem;
@@ -38,7 +39,8 @@ std::string FindTxt(const fs::path& dir, const std::string& stem) {
 
 }  // namespace
 
-KittiReader::KittiReader(const std::string& folder) : folder_(folder) {
+KittiReader::KittiReader(const std::string& folder)
+    : warnings_(std::make_shared<WarningLimiter>(folder)), folder_(folder) {
   const fs::path dir(folder);
   std::error_code ec;
   if (!fs::is_directory(dir / "velodyne", ec)) {
@@ -103,7 +105,10 @@ KittiReader::KittiReader(const std::string& folder) : folder_(folder) {
 }
 
 bool KittiReader::Next(ScanFrame* frame) {
-  if (next_ >= scans_.size()) return false;
+  if (next_ >= scans_.size()) {
+    warnings_->LogTotals();
+    return false;
+  }
   const int64_t stamp = times_[next_];
   constexpr int64_t kPeriod = 100'000'000;  // HDL-64E at 10 Hz
   frame->index = next_;
@@ -111,7 +116,9 @@ bool KittiReader::Next(ScanFrame* frame) {
   try {
     frame->cloud = ReadKittiBin(path, floats_per_point_, point_times_[next_], stamp);
   } catch (const UnusableCloudError& e) {
-    LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    if (warnings_->Count("unusable scan")) {
+      LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    }
     frame->cloud = PointCloud();
     frame->cloud.stamp_ns = stamp;
   }
@@ -138,8 +145,10 @@ bool KittiReader::Next(ScanFrame* frame) {
   if (frame->end_ns <= frame->start_ns) {
     // Recovery shared with the other layouts: without usable points (empty, all non-finite) or
     // with all points at one time the scan gets its nominal interval, up to the next stamp.
-    LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
-                 << " non-finite), all at one time; scan interval set to its nominal 0.1 s";
+    if (warnings_->Count("scan without an interval")) {
+      LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
+                   << " non-finite), all at one time; scan interval set to its nominal 0.1 s";
+    }
     const int64_t next_stamp = next_ + 1 < times_.size() ? times_[next_ + 1] : stamp + kPeriod;
     frame->end_ns = std::max(frame->start_ns + 1, std::min(stamp + kPeriod, next_stamp - 1));
   }

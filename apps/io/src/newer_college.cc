@@ -10,7 +10,9 @@
 #include <stdexcept>
 
 #include "ctlio/io/checked_output.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/text_table.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 namespace fs = std::filesystem;
@@ -30,12 +32,9 @@ void RequireDir(const fs::path& p) {
 SE3 PoseFromRow(const std::string& path, const TableRow& row, size_t first) {
   const Vec3 r(ToDouble(path, row, first), ToDouble(path, row, first + 1),
                ToDouble(path, row, first + 2));
-  const Eigen::Quaterniond q(ToDouble(path, row, first + 6), ToDouble(path, row, first + 3),
-                             ToDouble(path, row, first + 4), ToDouble(path, row, first + 5));
-  if (std::abs(q.norm() - 1.0) > 1e-3) {
-    FailAt(path, row.line, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
-  }
-  return SE3(q, r);
+  return CheckedGroundTruthPose(ToDouble(path, row, first + 6), ToDouble(path, row, first + 3),
+                                ToDouble(path, row, first + 4), ToDouble(path, row, first + 5), r,
+                                path + ":" + std::to_string(row.line) + ": ");
 }
 
 int64_t StampFromSecNsec(const std::string& path, const TableRow& row, size_t k) {
@@ -71,7 +70,7 @@ bool ParseNewerCollegeScanName(const std::string& name, int64_t* stamp_ns) {
 
 NewerCollegeReader::NewerCollegeReader(const std::string& folder,
                                        const NewerCollegeOptions& options)
-    : folder_(folder), options_(options) {
+    : warnings_(std::make_shared<WarningLimiter>(folder)), folder_(folder), options_(options) {
   const fs::path seq(folder);
   RequireDir(seq);
   RequireDir(ScanDir(seq));
@@ -134,7 +133,10 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
 }
 
 bool NewerCollegeReader::Next(ScanFrame* frame) {
-  if (next_ >= scans_.size()) return false;
+  if (next_ >= scans_.size()) {
+    warnings_->LogTotals();
+    return false;
+  }
   const auto& [stamp, path] = scans_[next_];
   // The scan's interval: from its stamp to the next scan's stamp (the last scan: one nominal
   // period, the median stamp spacing), with a tolerance for driver jitter.
@@ -148,14 +150,16 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
   try {
     frame->cloud = ReadPcd(path, ro);
   } catch (const UnusableCloudError& e) {
-    LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    if (warnings_->Count("unusable scan")) {
+      LOG(WARNING) << e.what() << "; handed on as an empty scan";
+    }
     frame->cloud = PointCloud();
     frame->cloud.stamp_ns = stamp;
   }
   PointCloud& c = frame->cloud;
   // Recovery: points whose time lies outside [stamp − tolerance, next stamp + tolerance] cannot be
   // placed on the trajectory between this scan and its neighbours; they are dropped, with a word.
-  DropPointsOutside(path, stamp - tolerance, next_stamp + tolerance, &c);
+  DropPointsOutside(path, stamp - tolerance, next_stamp + tolerance, &c, warnings_.get());
   frame->start_ns = stamp;
   frame->end_ns = stamp;
   for (int64_t t : c.times_ns) frame->end_ns = std::max(frame->end_ns, t);
@@ -164,9 +168,11 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
     // (empty, all non-finite) or with all points at the stamp the file gives no interval; the
     // scan gets its nominal one, up to the next stamp. An empty scan is reported degenerate by the
     // odometry.
-    LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
-                 << " non-finite), none after the stamp; scan interval set to ["
-                 << FormatSecondsNs(stamp) << ", " << FormatSecondsNs(next_stamp) << ") s";
+    if (warnings_->Count("scan without an interval")) {
+      LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
+                   << " non-finite), none after the stamp; scan interval set to ["
+                   << FormatSecondsNs(stamp) << ", " << FormatSecondsNs(next_stamp) << ") s";
+    }
     frame->end_ns = std::max(stamp + 1, next_stamp - 1);
   }
   frame->imu.clear();

@@ -15,8 +15,10 @@
 
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/extrinsic_check.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 namespace fs = std::filesystem;
@@ -100,7 +102,7 @@ std::string ImuFileName(size_t j) {
 }  // namespace
 
 SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_error_ns)
-    : folder_(folder) {
+    : warnings_(std::make_shared<WarningLimiter>(folder)), folder_(folder) {
   const fs::path dir(folder);
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw std::runtime_error(folder + ": folder not found");
@@ -213,16 +215,20 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       if (!ground_truth_.empty() && t <= ground_truth_.back().t_ns) {
         FailAt(gt_path, row.line, "ground-truth time not increasing");
       }
-      const Eigen::Quaterniond q(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
-                                 ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6));
-      if (std::abs(q.norm() - 1.0) > 1e-3) FailAt(gt_path, row.line, "quaternion norm is not 1");
-      ground_truth_.push_back({t, SE3(q, ToVec3(gt_path, row, 1))});
+      ground_truth_.push_back(
+          {t, CheckedGroundTruthPose(ToDouble(gt_path, row, 7), ToDouble(gt_path, row, 4),
+                                     ToDouble(gt_path, row, 5), ToDouble(gt_path, row, 6),
+                                     ToVec3(gt_path, row, 1),
+                                     gt_path + ":" + std::to_string(row.line) + ": ")});
     }
   }
 }
 
 bool SimFolderReader::Next(ScanFrame* frame) {
-  if (next_ >= scans_.size()) return false;
+  if (next_ >= scans_.size()) {
+    warnings_->LogTotals();
+    return false;
+  }
   const ScanEntry& e = scans_[next_];
   frame->index = next_;
   frame->cloud = ReadSimScan(e.file, e.start_ns);
@@ -234,7 +240,8 @@ bool SimFolderReader::Next(ScanFrame* frame) {
   // Recovery as in the Newer College reader: points timed outside the scan's interval (± 10 % of
   // its length) are dropped with a warning naming the file.
   const int64_t tolerance = std::max<int64_t>((e.end_ns - e.start_ns) / 10, 1);
-  DropPointsOutside(e.file, e.start_ns - tolerance, e.end_ns + tolerance, &frame->cloud);
+  DropPointsOutside(e.file, e.start_ns - tolerance, e.end_ns + tolerance, &frame->cloud,
+                    warnings_.get());
   frame->start_ns = e.start_ns;
   frame->end_ns = e.end_ns;
   frame->imu.clear();

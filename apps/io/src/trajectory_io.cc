@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/checked_output.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/text_table.h"
 
 namespace ctlio::io {
@@ -35,12 +36,10 @@ std::vector<StampedPose> ReadTum(const std::string& path) {
       FailAt(path, row.line, "time '" + row.fields[0] + "' is not a number");
     }
     CheckIncreasing(path, row, poses, t);
-    const Eigen::Quaterniond q(ToDouble(path, row, 7), ToDouble(path, row, 4),
-                               ToDouble(path, row, 5), ToDouble(path, row, 6));
-    if (std::abs(q.norm() - 1.0) > 1e-3) {
-      FailAt(path, row.line, "quaternion norm " + std::to_string(q.norm()) + " is not 1");
-    }
-    poses.push_back({t, SE3(q, ToVec3(path, row, 1))});
+    poses.push_back({t, CheckedGroundTruthPose(ToDouble(path, row, 7), ToDouble(path, row, 4),
+                                               ToDouble(path, row, 5), ToDouble(path, row, 6),
+                                               ToVec3(path, row, 1),
+                                               path + ":" + std::to_string(row.line) + ": ")});
   }
   return poses;
 }

@@ -22,16 +22,18 @@ void LidarFrontendOptions::Validate() const {
   require(keypoint_voxel_size > 0.0, "keypoint_voxel_size must be positive");
   require(max_keypoints >= 0, "max_keypoints must be >= 0 (0 = no cap)");
   require(map_voxel_size > 0.0, "map_voxel_size must be positive");
-  require(max_points_per_voxel >= 1, "max_points_per_voxel must be >= 1");
+  require(max_points_per_voxel >= 1 && max_points_per_voxel <= kMaxPointsPerVoxel,
+          "max_points_per_voxel must be in [1, 10000]");
   require(min_point_distance >= 0.0, "min_point_distance must be >= 0");
   require(max_map_distance > 0.0, "max_map_distance must be positive");
   require(min_neighbours >= 3, "min_neighbours must be >= 3 (a plane needs three points)");
-  require(max_neighbours >= min_neighbours, "max_neighbours must be >= min_neighbours");
+  require(max_neighbours >= min_neighbours && max_neighbours <= kMaxNeighbours,
+          "max_neighbours must be in [min_neighbours, 1000]");
   require(max_plane_distance > 0.0, "max_plane_distance must be positive");
   require(association == "knn" || association == "voxel_plane",
           "association must be knn or voxel_plane");
   require(voxel_plane_max_thickness >= 0.0, "voxel_plane_max_thickness must be >= 0");
-  require(threads >= 1, "threads must be >= 1");
+  require(threads >= 1 && threads <= kMaxConfigThreads, "threads must be in [1, 256]");
   require(max_iterations >= 1 && solver_iterations >= 1, "iteration counts must be >= 1");
   // Upper bounds: with zero convergence thresholds the solver runs to these on every scan, so an
   // unbounded value is a run that never ends.
@@ -66,15 +68,17 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"keypoint_voxel_size", SetFromYaml(&o.keypoint_voxel_size)},
       {"max_keypoints", SetFromYaml(&o.max_keypoints)},
       {"map_voxel_size", SetFromYaml(&o.map_voxel_size)},
-      {"max_points_per_voxel", SetFromYaml(&o.max_points_per_voxel)},
+      {"max_points_per_voxel", SetInRange(&o.max_points_per_voxel, 1, kMaxPointsPerVoxel, source,
+                                          "lidar_frontend.max_points_per_voxel")},
       {"min_point_distance", SetFromYaml(&o.min_point_distance)},
       {"max_map_distance", SetFromYaml(&o.max_map_distance)},
-      {"max_neighbours", SetFromYaml(&o.max_neighbours)},
+      {"max_neighbours",
+       SetInRange(&o.max_neighbours, 3, kMaxNeighbours, source, "lidar_frontend.max_neighbours")},
       {"min_neighbours", SetFromYaml(&o.min_neighbours)},
       {"max_plane_distance", SetFromYaml(&o.max_plane_distance)},
       {"association", SetFromYaml(&o.association)},
       {"voxel_plane_max_thickness", SetFromYaml(&o.voxel_plane_max_thickness)},
-      {"threads", SetFromYaml(&o.threads)},
+      {"threads", SetInRange(&o.threads, 1, kMaxConfigThreads, source, "lidar_frontend.threads")},
       {"max_iterations", SetFromYaml(&o.max_iterations)},
       {"solver_iterations", SetFromYaml(&o.solver_iterations)},
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},

@@ -133,7 +133,8 @@ void OdometryConfig::Validate() const {
   require(gap_velocity_walk > 0, "imu.gap_velocity_walk must be positive");
   require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
-  require(window_knots >= 2, "window.knots must be >= 2");
+  require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
+          "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
   require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
   for (const ImuSensor& s : imus) {
@@ -142,7 +143,8 @@ void OdometryConfig::Validate() const {
   // (Without `imus` the dataset may still declare them: RunOdometry fills the list.)
   require(input_imu >= 0 && input_imu < (imus.empty() ? 5 : num_imus()),
           "imu.input_imu must index an IMU of imus");
-  require(solver_threads >= 1, "window solver settings must be >= 1");
+  require(solver_threads >= 1 && solver_threads <= kMaxConfigThreads,
+          "window.threads must be in [1, 256]");
   degeneracy.Validate();
   calibration.Validate();
   require(calibration.time_offset_s.empty() ||
@@ -221,14 +223,16 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"max_imu_gap", SetFromYaml(&c->max_imu_gap)},
                    {"max_scan_translation", SetFromYaml(&c->max_scan_translation)}});
     } else if (key == "window") {
-      ReadSection(v, section, source,
-                  {{"knots", SetFromYaml(&c->window_knots)},
-                   {"knots_per_scan", SetFromYaml(&c->knots_per_scan)},
-                   {"threads", SetFromYaml(&c->solver_threads)},
-                   {"overlap", SetFromYaml(&c->overlap_stages)},
-                   {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
-                   {"imu_prediction", SetFromYaml(&c->imu_prediction)},
-                   {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
+      ReadSection(
+          v, section, source,
+          {{"knots", SetInRange(&c->window_knots, 2, kMaxWindowKnots, source, section + ".knots")},
+           {"knots_per_scan", SetFromYaml(&c->knots_per_scan)},
+           {"threads",
+            SetInRange(&c->solver_threads, 1, kMaxConfigThreads, source, section + ".threads")},
+           {"overlap", SetFromYaml(&c->overlap_stages)},
+           {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
+           {"imu_prediction", SetFromYaml(&c->imu_prediction)},
+           {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

@@ -13,13 +13,16 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <queue>
 
 #include "ctlio/io/bag_structure.h"
 #include "ctlio/io/extrinsic_check.h"
+#include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/ros_wire_check.h"
+#include "ctlio/io/warning_limiter.h"
 
 namespace ctlio::io {
 namespace {
@@ -44,12 +47,6 @@ struct StaticEdge {
         where + "transform " + msg.header.frame_id + " → " + msg.child_frame_id + ": ");
   }
 };
-SE3 FromRos(const geometry_msgs::Pose& p) {
-  return SE3(Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
-                 .normalized()
-                 .toRotationMatrix(),
-             Vec3(p.position.x, p.position.y, p.position.z));
-}
 
 // T_from_to over the static transform tree (edges parent → child hold T_parent_child), by a
 // breadth-first search that composes along the path; false if the frames are not connected.
@@ -177,6 +174,8 @@ struct RosbagSource::Impl {
   SE3 extrinsic;
   std::string extrinsic_origin;  // empty: unknown
   std::vector<StampedPose> ground_truth;
+  // Repeated warnings (IMU gaps, unusable scans): the first few in full, then a total at the end.
+  std::unique_ptr<WarningLimiter> warnings;
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw std::runtime_error(path + ": " + what);
@@ -194,6 +193,7 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
   Impl& s = *impl_;
   s.path = path;
   s.options = options;
+  s.warnings = std::make_unique<WarningLimiter>(path);
   if (!std::filesystem::is_regular_file(path)) s.Fail("file not found");
   if (!IsRosbagFile(path)) s.Fail("not a ROS 1 bag (no '#ROSBAG V2.0' header)");
   // The bag library trusts the file's lengths and offsets: check them first (bag_structure.h).
@@ -260,9 +260,18 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     if (topics.count(options.ground_truth_topic) &&
         topics.at(options.ground_truth_topic) == "nav_msgs/Odometry") {
       rosbag::View gt(s.bag, rosbag::TopicQuery(options.ground_truth_topic));
+      size_t gt_messages = 0;
       for (const rosbag::MessageInstance& m : gt) {
         const auto o = Instantiate<nav_msgs::Odometry>(m, path + ": ");
-        s.ground_truth.push_back({int64_t(o->header.stamp.toNSec()), FromRos(o->pose.pose)});
+        const geometry_msgs::Pose& p = o->pose.pose;
+        // The readers' one rule for ground truth (ground_truth_check.h): a NaN pose is an error
+        // naming the message, not an ATE of "nan" on a good run.
+        s.ground_truth.push_back(
+            {int64_t(o->header.stamp.toNSec()),
+             CheckedGroundTruthPose(p.orientation.w, p.orientation.x, p.orientation.y,
+                                    p.orientation.z, Vec3(p.position.x, p.position.y, p.position.z),
+                                    path + ": topic " + options.ground_truth_topic + ", message " +
+                                        std::to_string(++gt_messages) + ": ")});
       }
       std::stable_sort(s.ground_truth.begin(), s.ground_truth.end(),
                        [](const StampedPose& a, const StampedPose& b) { return a.t_ns < b.t_ns; });
@@ -325,8 +334,10 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
                                " s in the IMU (limit " +
                                std::to_string(1e-9 * double(options.max_imu_gap_ns)) + " s)");
     }
-    LOG(WARNING) << Where(imu_topic, imu_messages) << "gap of " << gap
-                 << " s in the IMU; samples handed on";
+    if (warnings->Count("IMU gap")) {
+      LOG(WARNING) << Where(imu_topic, imu_messages) << "gap of " << gap
+                   << " s in the IMU; samples handed on";
+    }
   }
   last_imu_ns = t;
   ImuSample s;
@@ -396,10 +407,12 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
                                " ns leaves no room for a scan period");
     }
     ++unusable_scans;
-    LOG(WARNING) << where << f.cloud.size() << " usable points (" << f.cloud.dropped_non_finite
-                 << " non-finite), " << (f.cloud.points.empty() ? "none" : "all at one instant")
-                 << ": handed on with its nominal interval [" << FormatSecondsNs(lo) << ", "
-                 << FormatSecondsNs(hi) << "] s (unusable scan " << unusable_scans << ")";
+    if (warnings->Count("unusable scan")) {
+      LOG(WARNING) << where << f.cloud.size() << " usable points (" << f.cloud.dropped_non_finite
+                   << " non-finite), " << (f.cloud.points.empty() ? "none" : "all at one instant")
+                   << ": handed on with its nominal interval [" << FormatSecondsNs(lo) << ", "
+                   << FormatSecondsNs(hi) << "] s (unusable scan " << unusable_scans << ")";
+    }
     f.start_ns = lo;
     f.end_ns = hi;
   }
@@ -442,6 +455,7 @@ bool RosbagSource::Next(ScanFrame* frame) {
     s.ReadOne();
   }
   if (s.pending.empty()) {
+    s.warnings->LogTotals();
     if (s.duplicates > 0) {
       LOG(WARNING) << s.path << ": dropped " << s.duplicates << " duplicate IMU sample(s)";
     }

@@ -97,9 +97,13 @@ void TakeImuUntil(const std::vector<ImuSample>& imu, int64_t end_ns, size_t* cur
 // out.
 void RequireFirstImuInBodyFrame(const DataSource& source, const std::string& target);
 
+class WarningLimiter;  // warning_limiter.h
+
 // Recovery shared by the readers: drops the points of `cloud` timed outside [lo_ns, hi_ns] (the
-// scan's interval with a tolerance), with a warning naming `path`. Returns how many.
-size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* cloud);
+// scan's interval with a tolerance), with a warning naming `path` (the first few of the sequence
+// only when `warnings` is given: the reader's limiter). Returns how many.
+size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, PointCloud* cloud,
+                         WarningLimiter* warnings = nullptr);
 
 // Checks an IMU stream read from `path` (lines[i] = line number of imu[i]) and applies the
 // documented recoveries, logged with glog:

@@ -12,6 +12,7 @@
 // forward (+x) direction: t = stamp − atan2(y, x)/(2π)·period, period 0.1 s.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ class KittiReader : public DataSource {
   std::optional<std::vector<StampedPose>> GroundTruth() const override;
 
  private:
+  // Repeated per-scan warnings (unusable scans, points outside the interval): the first few in
+  // full, then a total at the end of the sequence (warning_limiter.h).
+  std::shared_ptr<WarningLimiter> warnings_;
   std::string folder_;
   std::vector<std::string> scans_, point_times_;
   std::vector<int64_t> times_;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +50,9 @@ class NewerCollegeReader : public DataSource {
   const std::vector<ImuSample>& imu() const { return imu_; }
 
  private:
+  // Repeated per-scan warnings (unusable scans, points outside the interval): the first few in
+  // full, then a total at the end of the sequence (warning_limiter.h).
+  std::shared_ptr<WarningLimiter> warnings_;
   std::string folder_;
   NewerCollegeOptions options_;
   std::vector<std::pair<int64_t, std::string>> scans_;  // (stamp, path), sorted

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ class SimFolderReader : public DataSource {
     size_t points;
     std::string file;
   };
+  // Repeated per-scan warnings (unusable scans, points outside the interval): the first few in
+  // full, then a total at the end of the sequence (warning_limiter.h).
+  std::shared_ptr<WarningLimiter> warnings_;
   std::string folder_;
   SE3 imu_from_lidar_;
   std::optional<SE3> true_imu_from_lidar_;
