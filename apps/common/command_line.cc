@@ -43,7 +43,9 @@ void Wrapped(const std::string& text, size_t indent, size_t width, std::ostream&
       column += 1 + w.size();
     }
   }
-  if (column > 0) os << '\n';
+  if (column > 0) {
+    os << '\n';
+  }
 }
 
 }  // namespace
@@ -52,12 +54,16 @@ std::vector<gflags::CommandLineFlagInfo> OwnFlags() {
   std::set<std::string> foreign;
   for (const char* name : kForeignProbes) {
     gflags::CommandLineFlagInfo info;
-    if (gflags::GetCommandLineFlagInfo(name, &info)) foreign.insert(info.filename);
+    if (gflags::GetCommandLineFlagInfo(name, &info)) {
+      foreign.insert(info.filename);
+    }
   }
   std::vector<gflags::CommandLineFlagInfo> all, own;
   gflags::GetAllFlags(&all);  // sorted by file, then name
   for (const gflags::CommandLineFlagInfo& f : all) {
-    if (foreign.count(f.filename) == 0) own.push_back(f);
+    if (foreign.count(f.filename) == 0) {
+      own.push_back(f);
+    }
   }
   return own;
 }

@@ -50,7 +50,9 @@ inline constexpr int kMaxThreads = 256;
 template <typename T>
 void RequireInRange(const char* name, T value, T lo, T hi, const char* note = "") {
   static_assert(std::is_arithmetic_v<T>, "a count or a rate");
-  if (lo <= value && value <= hi) return;  // false for NaN
+  if (lo <= value && value <= hi) {
+    return;  // false for NaN
+  }
   std::ostringstream m;
   m.precision(10);
   m << "--" << name << '=' << value << " is out of range: must be in [" << lo << ", " << hi << ']'

@@ -7,7 +7,9 @@
 namespace ctlio::lioapp {
 
 std::string DescribeConfig(const std::string& path) {
-  if (path.empty()) return "built-in defaults (no --config)";
+  if (path.empty()) {
+    return "built-in defaults (no --config)";
+  }
   std::string text = path;
   std::string file = path;
   // LoadOdometryYaml allows 8 files in a chain; the bound also stops a cycle here.
@@ -19,9 +21,13 @@ std::string DescribeConfig(const std::string& path) {
       break;
     }
     const YAML::Node& read = root;  // a non-const operator[] would add the key
-    if (!read.IsMap() || !read["base"] || !read["base"].IsScalar()) break;
+    if (!read.IsMap() || !read["base"] || !read["base"].IsScalar()) {
+      break;
+    }
     std::filesystem::path base(read["base"].Scalar());
-    if (base.is_relative()) base = std::filesystem::path(file).parent_path() / base;
+    if (base.is_relative()) {
+      base = std::filesystem::path(file).parent_path() / base;
+    }
     file = base.lexically_normal().string();
     text += (depth == 0 ? " (extends " : ", which extends ") + file;
   }

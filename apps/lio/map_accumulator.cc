@@ -39,7 +39,9 @@ size_t MapAccumulator::bytes() const {
 size_t MapAccumulator::Find(uint64_t key) const {
   const size_t mask = keys_.size() - 1;
   size_t i = Slot(key, keys_.size());
-  while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask;  // linear probing
+  while (keys_[i] != kEmpty && keys_[i] != key) {
+    i = (i + 1) & mask;  // linear probing
+  }
   return i;
 }
 
@@ -51,7 +53,9 @@ void MapAccumulator::Grow() {
   peak_bytes_ = std::max(
       peak_bytes_, bytes() + old_keys.size() * sizeof(uint64_t) + old_cells.size() * sizeof(Cell));
   for (size_t i = 0; i < old_keys.size(); ++i) {
-    if (old_keys[i] == kEmpty) continue;
+    if (old_keys[i] == kEmpty) {
+      continue;
+    }
     const size_t j = Find(old_keys[i]);
     keys_[j] = old_keys[i];
     cells_[j] = old_cells[i];
@@ -59,8 +63,8 @@ void MapAccumulator::Grow() {
 }
 
 void MapAccumulator::Add(const std::vector<Vec3>& points, const SE3& T) {
-  const Mat3 R = T.rotation();
-  const Vec3 t = T.translation();
+  const Mat3& R = T.rotation();
+  const Vec3& t = T.translation();
   for (const Vec3& p_in : points) {
     ++added_;
     const Vec3 p = R * p_in + t;
@@ -68,7 +72,7 @@ void MapAccumulator::Add(const std::vector<Vec3>& points, const SE3& T) {
     bool inside = p.allFinite();
     for (int k = 0; k < 3 && inside; ++k) {
       const double v = std::floor(p[k] * inv_voxel_size_);
-      inside = v >= double(-kHalfRange) && v < double(kHalfRange);
+      inside = v >= static_cast<double>(-kHalfRange) && v < static_cast<double>(kHalfRange);
       index[k] = inside ? static_cast<int64_t>(v) : 0;
     }
     if (!inside) {
@@ -76,7 +80,9 @@ void MapAccumulator::Add(const std::vector<Vec3>& points, const SE3& T) {
       continue;
     }
     uint64_t key = 0;
-    for (int k = 0; k < 3; ++k) key = (key << kBits) | static_cast<uint64_t>(index[k] + kHalfRange);
+    for (int k = 0; k < 3; ++k) {
+      key = (key << kBits) | static_cast<uint64_t>(index[k] + kHalfRange);
+    }
     size_t slot = Find(key);
     if (keys_[slot] == kEmpty) {
       if (max_points_ > 0 && size_ >= max_points_) {
@@ -95,9 +101,15 @@ void MapAccumulator::Add(const std::vector<Vec3>& points, const SE3& T) {
     Cell& c = cells_[slot];
     c.n += 1;
     const float w = 1.0f / static_cast<float>(c.n);
-    c.dx += (static_cast<float>(p.x() - (double(index[0]) + 0.5) * voxel_size_) - c.dx) * w;
-    c.dy += (static_cast<float>(p.y() - (double(index[1]) + 0.5) * voxel_size_) - c.dy) * w;
-    c.dz += (static_cast<float>(p.z() - (double(index[2]) + 0.5) * voxel_size_) - c.dz) * w;
+    c.dx +=
+        (static_cast<float>(p.x() - (static_cast<double>(index[0]) + 0.5) * voxel_size_) - c.dx) *
+        w;
+    c.dy +=
+        (static_cast<float>(p.y() - (static_cast<double>(index[1]) + 0.5) * voxel_size_) - c.dy) *
+        w;
+    c.dz +=
+        (static_cast<float>(p.z() - (static_cast<double>(index[2]) + 0.5) * voxel_size_) - c.dz) *
+        w;
   }
 }
 
@@ -112,11 +124,15 @@ std::vector<Vec3> MapAccumulator::Points() const {
   const uint64_t field = (uint64_t{1} << kBits) - 1;
   for (size_t i = 0; i < keys_.size(); ++i) {
     const uint64_t key = keys_[i];
-    if (key == kEmpty) continue;
+    if (key == kEmpty) {
+      continue;
+    }
     const Cell& c = cells_[i];
-    const double ix = double(int64_t((key >> (2 * kBits)) & field) - kHalfRange);
-    const double iy = double(int64_t((key >> kBits) & field) - kHalfRange);
-    const double iz = double(int64_t(key & field) - kHalfRange);
+    const double ix =
+        static_cast<double>(static_cast<int64_t>((key >> (2 * kBits)) & field) - kHalfRange);
+    const double iy =
+        static_cast<double>(static_cast<int64_t>((key >> kBits) & field) - kHalfRange);
+    const double iz = static_cast<double>(static_cast<int64_t>(key & field) - kHalfRange);
     out.emplace_back((ix + 0.5) * voxel_size_ + c.dx, (iy + 0.5) * voxel_size_ + c.dy,
                      (iz + 0.5) * voxel_size_ + c.dz);
   }

@@ -16,7 +16,9 @@ namespace {
 // A shell word: single quotes, with every ' inside closed, escaped and reopened.
 std::string Quoted(const std::string& s) {
   std::string q = "'";
-  for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  for (const char c : s) {
+    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  }
   return q + "'";
 }
 
@@ -36,14 +38,20 @@ void CheckMapFlags(const std::string& file, double voxel_size, int64_t max_point
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
     throw std::runtime_error("--map_voxel_size must be a finite number > 0 [m]");
   }
-  if (max_points < 0) throw std::runtime_error("--map_max_points must be >= 0 (0 = no cap)");
+  if (max_points < 0) {
+    throw std::runtime_error("--map_max_points must be >= 0 (0 = no cap)");
+  }
 }
 
 std::string MapPath(const std::string& file, const std::string& out, const std::string& method,
                     bool several_methods) {
   const std::filesystem::path p(file);
-  if (p.is_relative()) return (std::filesystem::path(out) / p).string();
-  if (!several_methods) return file;
+  if (p.is_relative()) {
+    return (std::filesystem::path(out) / p).string();
+  }
+  if (!several_methods) {
+    return file;
+  }
   std::filesystem::path named = p.parent_path() / (p.stem().string() + "_" + method);
   named += p.extension();
   return named.string();
@@ -71,14 +79,16 @@ void WriteMap(const MapAccumulator& map, const std::string& path, const std::str
   ev << "map_file \"" << path << "\"\nmap_points " << map.size() << "\nmap_voxel_size_m "
      << map.voxel_size() << "\nmap_points_added " << map.added_points()
      << "\nmap_points_dropped_cap " << map.dropped_points() << "\nmap_peak_mb "
-     << double(map.peak_bytes()) * mb << "\n";
+     << static_cast<double>(map.peak_bytes()) * mb << "\n";
   std::fprintf(stderr,
                "map: %zu points (%g m voxels, from %zu; %zu dropped at --map_max_points), file "
                "%.1f MB, voxel table peak %.1f MB: %s\n",
                map.size(), map.voxel_size(), map.added_points(), map.dropped_points(),
-               double(std::filesystem::file_size(path)) * mb, double(map.peak_bytes()) * mb,
-               path.c_str());
-  if (!plot) return;
+               double(std::filesystem::file_size(path)) * mb,
+               static_cast<double>(map.peak_bytes()) * mb, path.c_str());
+  if (!plot) {
+    return;
+  }
   const std::string png = MapPicturePath(path);
   if (python.empty()) {
     std::fprintf(stderr, "map: no python3 with matplotlib, no picture %s\n", png.c_str());

@@ -15,9 +15,13 @@ void OutputFiles::Add(const std::string& path, const std::string& description) {
 }
 
 void OutputFiles::Print(std::ostream& os) const {
-  if (entries_.empty()) return;
+  if (entries_.empty()) {
+    return;
+  }
   size_t width = 0;
-  for (const Entry& e : entries_) width = std::max(width, e.path.size());
+  for (const Entry& e : entries_) {
+    width = std::max(width, e.path.size());
+  }
   os << "Files written:\n";
   for (const Entry& e : entries_) {
     os << "  " << e.path << std::string(width - e.path.size(), ' ') << "  " << e.description

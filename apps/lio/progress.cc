@@ -39,7 +39,9 @@ void ProgressReporter::Update(size_t done, size_t total, const std::string& text
 }
 
 void ProgressReporter::Event(const std::string& text) {
-  if (events_++ >= max_events_) return;
+  if (events_++ >= max_events_) {
+    return;
+  }
   EndOpenLine();
   os_ << text << '\n' << std::flush;
 }
@@ -51,7 +53,9 @@ void ProgressReporter::SetEventLimit(size_t max_events, const std::string& where
 
 void ProgressReporter::Finish() {
   EndOpenLine();
-  if (!pending_.empty()) os_ << pending_ << '\n';
+  if (!pending_.empty()) {
+    os_ << pending_ << '\n';
+  }
   pending_.clear();
   if (events_ > max_events_) {
     os_ << "  (" << events_ - max_events_ << " more such lines not shown"
@@ -62,7 +66,9 @@ void ProgressReporter::Finish() {
 }
 
 void ProgressReporter::EndOpenLine() {
-  if (line_open_) os_ << '\n';
+  if (line_open_) {
+    os_ << '\n';
+  }
   line_open_ = false;
 }
 

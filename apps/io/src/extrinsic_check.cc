@@ -17,8 +17,12 @@ SE3 CheckedExtrinsic(double qw, double qx, double qy, double qz, const Vec3& t,
       << " " << qz << ", translation = " << t.x() << " " << t.y() << " " << t.z() << ")";
     throw std::runtime_error(s.str());
   };
-  if (!q.allFinite()) fail("quaternion is not finite");
-  if (!t.allFinite()) fail("translation is not finite");
+  if (!q.allFinite()) {
+    fail("quaternion is not finite");
+  }
+  if (!t.allFinite()) {
+    fail("translation is not finite");
+  }
   const double n2 = q.squaredNorm();
   if (!(std::abs(n2 - 1.0) <= kQuaternionNormSqTolerance)) {
     std::ostringstream s;

@@ -25,10 +25,12 @@ void WriteXyz(std::ofstream& out, const std::vector<Vec3>& points) {
         const float v = static_cast<float>(points[begin + i][k]);
         uint32_t bits;
         std::memcpy(&bits, &v, 4);
-        for (int b = 0; b < 4; ++b) buffer[12 * i + 4 * k + b] = (bits >> (8 * b)) & 0xFF;
+        for (int b = 0; b < 4; ++b) {
+          buffer[12 * i + 4 * k + b] = (bits >> (8 * b)) & 0xFF;
+        }
       }
     }
-    out.write(reinterpret_cast<const char*>(buffer.data()), std::streamsize(12 * n));
+    out.write(reinterpret_cast<const char*>(buffer.data()), static_cast<std::streamsize>(12 * n));
   }
 }
 
@@ -36,8 +38,12 @@ void WriteXyz(std::ofstream& out, const std::vector<Vec3>& points) {
 
 MapFormat MapFormatOf(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".pcd") return MapFormat::kPcd;
-  if (ext == ".ply") return MapFormat::kPly;
+  if (ext == ".pcd") {
+    return MapFormat::kPcd;
+  }
+  if (ext == ".ply") {
+    return MapFormat::kPly;
+  }
   throw std::invalid_argument(path + ": a map file must end in .pcd or .ply");
 }
 

@@ -9,20 +9,24 @@ void CheckPointFields(const std::vector<PointField>& fields, uint64_t point_step
   auto fail = [&](const std::string& what) {
     throw std::runtime_error(where + what + " (fields found: " + DescribeFields(fields) + ")");
   };
-  if (point_step == 0) fail("point_step is 0");
+  if (point_step == 0) {
+    fail("point_step is 0");
+  }
   if (point_step > kMaxPointRecordBytes) {
     fail("point_step " + std::to_string(point_step) + " B exceeds " +
          std::to_string(kMaxPointRecordBytes) + " B");
   }
   for (const PointField& f : fields) {
     const uint64_t size = FieldDatatypeSize(f.datatype);
-    if (size == 0) fail("field '" + f.name + "' has an unknown datatype");
+    if (size == 0) {
+      fail("field '" + f.name + "' has an unknown datatype");
+    }
     if (f.count > kMaxFieldElements) {
       fail("field '" + f.name + "' has count " + std::to_string(f.count) + " (at most " +
            std::to_string(kMaxFieldElements) + ")");
     }
     // 32-bit offset + 8 × 2^16 fits 64 bits: no overflow.
-    const uint64_t end = uint64_t(f.offset) + size * f.count;
+    const uint64_t end = static_cast<uint64_t>(f.offset) + size * f.count;
     if (end > point_step) {
       fail("field '" + f.name + "' ends past the point step of " + std::to_string(point_step) +
            " B (" + std::to_string(f.count) + " × " + FieldDatatypeName(f.datatype) + " at byte " +
@@ -71,7 +75,9 @@ void CheckPointBytes(const PointBlock& b, uint64_t data_bytes, const std::string
   if (data_bytes != needed) {
     std::string shape = std::to_string(b.height) + " × " + std::to_string(b.width) + " points of " +
                         std::to_string(b.point_step) + " B";
-    if (b.row_step != row_bytes) shape += " in rows of " + std::to_string(b.row_step) + " B";
+    if (b.row_step != row_bytes) {
+      shape += " in rows of " + std::to_string(b.row_step) + " B";
+    }
     fail(what + " holds " + std::to_string(data_bytes) + " B; " + shape + " need " +
          std::to_string(needed) + " B");
   }

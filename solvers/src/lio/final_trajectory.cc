@@ -6,7 +6,9 @@
 namespace ctlio::lio {
 
 void FinalTrajectory::MarkFailed(double t_begin, double t_end) {
-  if (rate_hz_ > 0.0) failed_.emplace_back(t_begin, t_end);
+  if (rate_hz_ > 0.0) {
+    failed_.emplace_back(t_begin, t_end);
+  }
 }
 
 bool FinalTrajectory::Failed(double t) const {
@@ -32,17 +34,27 @@ void FinalTrajectory::SegmentTimes(std::optional<double> from, double t_b, int64
 }
 
 void FinalTrajectory::SealOldest(Estimator* estimator, int64_t origin_ns) {
-  if (rate_hz_ <= 0.0) return;
+  if (rate_hz_ <= 0.0) {
+    return;
+  }
   const double t_k = estimator->StateTimes().front();
   const bool failed = Failed(t_k);
   std::vector<int64_t> ns;
   std::vector<double> t;
-  if (!failed) SegmentTimes(sealed_, t_k, origin_ns, &ns, &t);
+  if (!failed) {
+    SegmentTimes(sealed_, t_k, origin_ns, &ns, &t);
+  }
   const std::vector<SE3> poses = estimator->SealOldest(t);
-  for (size_t i = 0; i < ns.size(); ++i) samples_.emplace_back(ns[i], poses[i]);
+  for (size_t i = 0; i < ns.size(); ++i) {
+    samples_.emplace_back(ns[i], poses[i]);
+  }
   sealed_.reset();
-  if (!failed) sealed_ = t_k;
-  while (!failed_.empty() && failed_.front().second <= t_k) failed_.pop_front();
+  if (!failed) {
+    sealed_ = t_k;
+  }
+  while (!failed_.empty() && failed_.front().second <= t_k) {
+    failed_.pop_front();
+  }
 }
 
 FinalTrajectory::Samples FinalTrajectory::Take() {
@@ -54,7 +66,9 @@ FinalTrajectory::Samples FinalTrajectory::Take() {
 FinalTrajectory::Samples FinalTrajectory::Tail(const Estimator& estimator,
                                                int64_t origin_ns) const {
   Samples out;
-  if (rate_hz_ <= 0.0 || estimator.num_states() == 0) return out;
+  if (rate_hz_ <= 0.0 || estimator.num_states() == 0) {
+    return out;
+  }
   std::vector<int64_t> ns;
   std::vector<double> t;
   std::optional<double> from = sealed_;
@@ -67,7 +81,9 @@ FinalTrajectory::Samples FinalTrajectory::Tail(const Estimator& estimator,
     from = t_k;
   }
   const std::vector<SE3> poses = estimator.UnsealedPoses(t);
-  for (size_t i = 0; i < ns.size(); ++i) out.emplace_back(ns[i], poses[i]);
+  for (size_t i = 0; i < ns.size(); ++i) {
+    out.emplace_back(ns[i], poses[i]);
+  }
   return out;
 }
 

@@ -34,10 +34,10 @@ class Wire {
   // An array length, bounded by what its smallest element leaves room for.
   uint32_t Count(size_t min_element_bytes, const char* what) {
     const uint32_t n = U32(what);
-    if (uint64_t(n) * min_element_bytes > size_ - pos_) {
+    if (static_cast<uint64_t>(n) * min_element_bytes > size_ - pos_) {
       Fail(std::string(what) + " count " + std::to_string(n) + " needs at least " +
-           std::to_string(uint64_t(n) * min_element_bytes) + " B, " + std::to_string(size_ - pos_) +
-           " B left");
+           std::to_string(static_cast<uint64_t>(n) * min_element_bytes) + " B, " +
+           std::to_string(size_ - pos_) + " B left");
     }
     return n;
   }
@@ -46,7 +46,9 @@ class Wire {
     String("header frame_id");
   }
   void End() const {
-    if (pos_ != size_) Fail(std::to_string(size_ - pos_) + " B after the message's last field");
+    if (pos_ != size_) {
+      Fail(std::to_string(size_ - pos_) + " B after the message's last field");
+    }
   }
 
  private:

@@ -36,11 +36,13 @@ M ReadCheckedMessage(const rosbag::MessageInstance& m, const std::string& where,
   }
   // m.size() is the record's data length, which the bag structure check bounded by its chunk.
   std::vector<uint8_t> bytes(m.size());
-  ros::serialization::OStream out(bytes.data(), uint32_t(bytes.size()));
+  ros::serialization::OStream out(bytes.data(), static_cast<uint32_t>(bytes.size()));
   m.write(out);
-  if (check) check(bytes.data(), bytes.size(), where);
+  if (check) {
+    check(bytes.data(), bytes.size(), where);
+  }
   M msg;
-  ros::serialization::IStream in(bytes.data(), uint32_t(bytes.size()));
+  ros::serialization::IStream in(bytes.data(), static_cast<uint32_t>(bytes.size()));
   ros::serialization::deserialize(in, msg);
   return msg;
 }
