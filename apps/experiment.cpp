@@ -60,8 +60,9 @@
 
 DEFINE_string(out, "", "Output folder (required)");
 DEFINE_string(config, "",
-              "YAML config (default: data/sim_lio.yaml of the source tree, "
-              "data/newer_college_lio.yaml with --sim_preset newer_college)");
+              "YAML config, or a comma-separated list whose later files win key by key "
+              "(default: data/sim_lio.yaml of the source tree, data/newer_college_lio.yaml with "
+              "--sim_preset newer_college)");
 DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes (also walking, vehicle)");
 DEFINE_string(sim_preset, "",
               "Recording preset: none | newer_college (sets world, regime, sensors, IMU, duration; "

@@ -57,6 +57,7 @@
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
+#include "ctlio/solvers/lio/config_composition.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
 #include "lio/config_origin.h"
@@ -93,8 +94,9 @@ DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
 DEFINE_string(config, "",
-              "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml); empty: the built-in "
-              "defaults");
+              "YAML config (data/sim_lio.yaml, data/newer_college_lio.yaml), or a comma-separated "
+              "list whose later files win key by key (my.yaml,data/calibration.yaml); empty: the "
+              "built-in defaults");
 DEFINE_string(out, "", "Output folder (created); with several methods one subfolder per method");
 DEFINE_int32(max_scans, 0, "Stop after this many scans (0 = all; negative is an error)");
 DEFINE_double(max_imu_gap_error, 0.0,
@@ -140,9 +142,9 @@ DEFINE_string(time_offset, "",
               "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
               "mean when estimated, else applied as given");
 DEFINE_bool(calibration_keep_unobservable, true,
-            "calibration.yaml keeps the start value of every calibration coordinate that was "
-            "unobservable after more than half of the scans (its estimate is not a calibration); "
-            "false writes the last estimates as they are");
+            "calibration.yaml keeps the start value of every calibration coordinate whose sigma "
+            "is not below its threshold (calibration.write_max_sigma_s/_deg/_m: the data did not "
+            "inform it); false writes the last estimates as they are");
 DEFINE_string(sim_extrinsic_error, "",
               "--format sim: hand the odometry a NOMINAL extrinsic off the simulated one by "
               "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "
@@ -350,7 +352,7 @@ int main(int argc, char** argv) {
     if (!FLAGS_config.empty()) {
       const YAML::Node root = lio::LoadOdometryYaml(FLAGS_config);
       config_extrinsic = root["extrinsic"].IsDefined();
-      base = lio::OdometryConfigFromYaml(root, FLAGS_config);
+      base = lio::OdometryConfigFromYaml(root, lio::SplitConfigList(FLAGS_config).back());
     }
     std::printf("config: %s\n", lioapp::DescribeConfig(FLAGS_config).c_str());
     std::fflush(stdout);
@@ -426,8 +428,8 @@ int main(int argc, char** argv) {
       }
       lioapp::RunSummary run = lioapp::RunOdometry(*source, config, options);
       // The calibration.yaml values, also summarised in evaluation.txt.
-      const auto recommended =
-          lioapp::RecommendCalibration(run, FLAGS_calibration_keep_unobservable);
+      const auto recommended = lioapp::RecommendCalibration(run, config.calibration,
+                                                            FLAGS_calibration_keep_unobservable);
       if (FLAGS_progress) progress.Finish();
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       files.Add(out + "/trajectory.tum",
@@ -529,7 +531,7 @@ int main(int argc, char** argv) {
           for (const std::string& n : recommended->kept_at_start) {
             names += " " + n;
           }
-          LOG(WARNING) << "Calibration: unobservable after most scans (the motion did not excite "
+          LOG(WARNING) << "Calibration: sigma not below the threshold (the data did not inform "
                           "them), written at their start values in "
                        << out << "/calibration.yaml:" << names;
         }

@@ -18,6 +18,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <random>
@@ -25,6 +28,7 @@
 
 #include "common/command_line.h"
 #include "common/preset_flags.h"
+#include "ctlio/io/checked_output.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
@@ -72,7 +76,7 @@ DEFINE_uint64(seed, ctlio::sim::kExperimentSeed, "Experiment seed (documented de
 DEFINE_double(duration, 20.0, "Sequence length [s]");
 DEFINE_double(start_s, 0.0,
               "Absolute time of the sequence start [s] (0 = 0, or 1 s for a bag: ROS 1 bags cannot "
-              "hold time 0)");
+              "hold time 0; and for the Newer College layout with --imu_stamp_offset > 0)");
 DEFINE_int32(firing_decimation, 1, "Keep every n-th lidar firing (1 = full resolution)");
 DEFINE_int32(beams, 128, "Lidar beams");
 DEFINE_bool(body_centric, false, "Generate the paper's body-centric accelerometer (no ω×v)");
@@ -82,8 +86,12 @@ DEFINE_int32(pillars, 0, "Interior 1 m × 1 m pillars placed at random (seeded) 
 DEFINE_bool(ground_truth, true, "Write the ground-truth trajectory");
 DEFINE_string(extrinsic_error, "",
               "Write a NOMINAL lidar->IMU extrinsic off the true one by <angle>deg[@ax:ay:az],"
-              "<distance>m[@dx:dy:dz] (axis/direction drawn per --index when omitted; the truth "
-              "goes to true_imu_from_lidar), e.g. 3deg,0.10m (apps/sim extrinsic_error.h)");
+              "<distance>m[@dx:dy:dz] (axis/direction drawn per --index when omitted), e.g. "
+              "3deg,0.10m (apps/sim extrinsic_error.h), in every layout: ctlio_sim.yaml (the "
+              "truth in true_imu_from_lidar), a bag's /tf_static, the Newer College layout's "
+              "published extrinsic (the truth off it); bags and Newer College folders get the "
+              "truth as a config overlay, <bag stem>_true_calibration.yaml / "
+              "<folder>/true_calibration.yaml");
 DEFINE_bool(newer_college_extrinsic, false,
             "Use the Newer College lidar→IMU extrinsic instead of identity (always used with "
             "--layout=newer_college, which cannot carry another)");
@@ -97,6 +105,29 @@ std::optional<T> Given(const char* flag, const T& value) {
 }
 
 // "a,b,c" → Vec3 (one number repeats on all axes).
+// The simulated calibration as an odometry config overlay (docs/user-guide/configuration.md,
+// "Composing configs"): the true extrinsic and IMU 0's clock offset, so that
+// --config my.yaml,<this> runs with the true values; comments give the nominal the data carry.
+void WriteTrueCalibration(const std::string& path, const ctlio::sim::SimConfig& config,
+                          double time_offset_s) {
+  const ctlio::SE3& T = config.imu_from_lidar;
+  const ctlio::SE3 nominal = config.nominal_imu_from_lidar.value_or(T);
+  std::ofstream f = ctlio::io::OpenForWriting(path);
+  f << std::setprecision(12)
+    << "# ctlio_simulate: the true lidar-IMU calibration of this recording, as an odometry config\n"
+    << "# overlay (--config my.yaml," << std::filesystem::path(path).filename().string()
+    << " runs with the true values).\n# The data carry the nominal extrinsic (translation ["
+    << nominal.translation().x() << ", " << nominal.translation().y() << ", "
+    << nominal.translation().z() << "]) and IMU 0's samples stamped " << time_offset_s
+    << " s early.\ncalibration:\n  time_offset_s: [" << time_offset_s << "]\nextrinsic:\n"
+    << "  rotation: [";
+  const ctlio::Mat3 R = T.rotation();
+  for (int i = 0; i < 9; ++i) f << (i > 0 ? ", " : "") << R(i / 3, i % 3);
+  f << "]\n  translation: [" << T.translation().x() << ", " << T.translation().y() << ", "
+    << T.translation().z() << "]\n";
+  ctlio::io::CloseChecked(f, path);
+}
+
 ctlio::Vec3 ParseVec3(const std::string& flag, const std::string& text) {
   std::stringstream in(text);
   std::vector<double> v;
@@ -198,16 +229,27 @@ int main(int argc, char** argv) {
     if (FLAGS_layout == "newer_college") config.imu_from_lidar = io::NewerCollegeImuFromLidar();
     const sim::ExtrinsicError extrinsic_error = sim::ParseExtrinsicError(FLAGS_extrinsic_error);
     if (!extrinsic_error.IsZero()) {
-      if (FLAGS_layout != "ctlio") {
-        throw std::runtime_error(
-            "--extrinsic_error needs --layout ctlio (the only layout that "
-            "records the true extrinsic next to the nominal one)");
+      if (FLAGS_layout == "newer_college") {
+        // The layout is read with the published extrinsic, so that one is the nominal and the
+        // lidar moves with a truth off it by the inverse error: C_nom = Exp(θa)·C_true and
+        // p_nom = p_true + s·d (extrinsic_error.h) with Exp(θa), s·d the nominal of the identity.
+        const SE3 e = sim::NominalExtrinsic(SE3(), extrinsic_error, FLAGS_seed, FLAGS_index);
+        const SE3 nominal = config.imu_from_lidar;
+        config.imu_from_lidar = SE3(e.rotation().transpose() * nominal.rotation(),
+                                    nominal.translation() - e.translation());
+        config.nominal_imu_from_lidar = nominal;
+      } else {
+        config.nominal_imu_from_lidar =
+            sim::NominalExtrinsic(config.imu_from_lidar, extrinsic_error, FLAGS_seed, FLAGS_index);
       }
-      config.nominal_imu_from_lidar =
-          sim::NominalExtrinsic(config.imu_from_lidar, extrinsic_error, FLAGS_seed, FLAGS_index);
     }
     config.start_ns = std::llround(FLAGS_start_s * 1e9);
     if (FLAGS_layout == "rosbag" && config.start_ns == 0) config.start_ns = 1'000'000'000;
+    // IMU stamps early by a clock offset would be negative at 0, which the Newer College CSV
+    // (sec, nsec) cannot hold.
+    if (FLAGS_layout == "newer_college" && config.start_ns == 0 && FLAGS_imu_stamp_offset > 0) {
+      config.start_ns = 1'000'000'000;
+    }
     std::mt19937_64 rng(FLAGS_seed + 17);
     std::uniform_real_distribution<double> u(-40.0, 40.0);
     for (int i = 0; i < FLAGS_pillars; ++i) {
@@ -280,6 +322,16 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "scan %zu/%zu (%3.0f %%)  %.1f s\n", done, total,
                    100.0 * double(done) / double(std::max<size_t>(total, 1)), s);
     };
+    // The truth of what the data carry wrong (the nominal extrinsic, IMU 0's stamps), beside
+    // the layouts that have no place for it (ctlio_sim.yaml records it in the ctlio layout).
+    std::string truth_path;
+    if (FLAGS_layout == "rosbag") {
+      std::string stem = FLAGS_output;
+      if (stem.size() > 4 && stem.substr(stem.size() - 4) == ".bag") stem.resize(stem.size() - 4);
+      truth_path = stem + "_true_calibration.yaml";
+    } else if (FLAGS_layout == "newer_college") {
+      truth_path = FLAGS_output + "/true_calibration.yaml";
+    }
     size_t n = 0;
     if (FLAGS_layout == "ctlio") {
       n = io::WriteSimFolder(source, FLAGS_output, yaml.str(), progress, FLAGS_ground_truth);
@@ -297,6 +349,10 @@ int main(int argc, char** argv) {
       }
     } else {
       throw std::runtime_error("unknown --layout '" + FLAGS_layout + "'");
+    }
+    if (!truth_path.empty() && (!extrinsic_error.IsZero() || FLAGS_imu_stamp_offset != 0.0)) {
+      WriteTrueCalibration(truth_path, config, FLAGS_imu_stamp_offset);
+      LOG(INFO) << "the true calibration (an odometry config overlay): " << truth_path;
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     LOG(INFO) << "wrote " << n << " scans to " << FLAGS_output << " in " << s << " s";

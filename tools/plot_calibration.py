@@ -62,38 +62,31 @@ def held_spans(t, held):
     return spans(t, [h == 1 for h in held])
 
 
-def read_truth(folder):
-    """{imu index: true offset [s]} from calibration.yaml's comments (ctlio_odometry writes them)."""
+def read_truths(folder):
+    """{series key: true value in calibration.csv's unit} from calibration.yaml's per-coordinate
+    blocks ("# <coordinate> [ms|cm|deg]" ... "#   truth      <value>", simulator runs only): the
+    IMU index for a time offset [s], the column name for the extrinsic's rho [m] / phi [deg]."""
     truth = {}
     path = os.path.join(folder, "calibration.yaml")
     if not os.path.exists(path):
         return truth
+    coordinate = None
     with open(path) as f:
         for line in f:
-            m = re.match(r"# IMU (\d+): .*truth ([-+0-9.eE]+) ms", line)
+            m = re.match(r"# (time_offset_\d+|extrinsic_(?:rho|phi)_[xyz]) \[(ms|cm|deg)\]", line)
             if m:
-                truth[int(m.group(1))] = 1e-3 * float(m.group(2))
+                coordinate = m.group(1)
+                continue
+            m = re.match(r"#   truth +([-+0-9.eE]+|nan|inf)", line)
+            if m and coordinate:
+                v = float(m.group(1))
+                if coordinate.startswith("time_offset_"):
+                    truth[int(coordinate[len("time_offset_"):])] = 1e-3 * v
+                elif coordinate.startswith("extrinsic_rho_"):
+                    truth[coordinate + "_m"] = 1e-2 * v
+                else:
+                    truth[coordinate + "_deg"] = v
     return truth
-
-
-def read_extrinsic_truth(folder):
-    """{column: true value} of the extrinsic's deviation from the start (calibration.yaml's comment
-    "# Extrinsic truth from the start: rho = [..] m, phi = [..] deg", simulator runs only)."""
-    path = os.path.join(folder, "calibration.yaml")
-    if not os.path.exists(path):
-        return {}
-    num = r"([-+0-9.eE]+)"
-    vec = r"\[" + num + r", " + num + r", " + num + r"\]"
-    with open(path) as f:
-        for line in f:
-            m = re.match(r"# Extrinsic truth from the start: rho = " + vec + r" m, phi = " + vec,
-                         line)
-            if m:
-                v = [float(x) for x in m.groups()]
-                keys = [f"extrinsic_rho_{a}_m" for a in "xyz"] + \
-                       [f"extrinsic_phi_{a}_deg" for a in "xyz"]
-                return dict(zip(keys, v))
-    return {}
 
 
 def plot(folder):
@@ -126,8 +119,7 @@ def plot(folder):
     live_path = os.path.join(folder, "calibration_live.csv")
     live = read_columns(live_path) if os.path.exists(live_path) else {}
     t_live = [x - t0 for x in live.get("t_s", [])]
-    truth = read_truth(folder)
-    truth.update(read_extrinsic_truth(folder))
+    truth = read_truths(folder)
     fig, axes = plt.subplots(len(series), 1, figsize=(8, 2.6 * len(series)), squeeze=False)
     for ax, (label, key, sigma_key, scale, imu, coordinate) in zip(axes[:, 0], series):
         est = [scale * v for v in cols[key]]

@@ -4,10 +4,37 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <sstream>
 
 #include "ctlio/io/checked_output.h"
 
 namespace ctlio::lioapp {
+
+namespace {
+
+// A coordinate's display unit: δ in ms, ρ in cm, φ in degrees (from SI: s, m, rad).
+struct Unit {
+  const char* name;
+  double scale;
+};
+Unit DisplayUnit(const std::string& coordinate) {
+  if (coordinate.rfind("time_offset_", 0) == 0) return {"ms", 1e3};
+  if (coordinate.rfind("extrinsic_rho_", 0) == 0) return {"cm", 1e2};
+  return {"deg", 180.0 / M_PI};
+}
+
+// "0.5 ms (calibration.write_max_sigma_s)": a threshold in the coordinate's display unit.
+std::string Threshold(const std::string& coordinate, double threshold) {
+  const Unit u = DisplayUnit(coordinate);
+  const char* key = coordinate.rfind("time_offset_", 0) == 0     ? "write_max_sigma_s"
+                    : coordinate.rfind("extrinsic_rho_", 0) == 0 ? "write_max_sigma_m"
+                                                                 : "write_max_sigma_deg";
+  std::ostringstream text;
+  text << u.scale * threshold << ' ' << u.name << " (calibration." << key << ")";
+  return text.str();
+}
+
+}  // namespace
 
 const lio::ScanResult* LastCalibration(const RunSummary& run) {
   for (auto it = run.scans.rbegin(); it != run.scans.rend(); ++it) {
@@ -41,26 +68,29 @@ void WriteObservabilitySummary(const RunSummary& run,
                                const std::optional<RecommendedCalibration>& recommended,
                                std::ostream& out) {
   const lio::ScanResult* last = LastCalibration(run);
-  if (last == nullptr || !HasObservability(run)) return;
-  const std::vector<std::string> names = CalibrationCoordinates(last->calibration);
-  const std::vector<double> fraction = UnobservableFraction(run);
-  const auto& c = last->calibration;
-  out << "calibration_unobservable_final";
-  bool none = true;
-  for (size_t i = 0; i < names.size() && i < c.unobservable.size(); ++i) {
-    if (!c.unobservable[i]) continue;
-    out << ' ' << names[i];
-    none = false;
+  if (last == nullptr) return;
+  if (HasObservability(run)) {
+    const std::vector<std::string> names = CalibrationCoordinates(last->calibration);
+    const std::vector<double> fraction = UnobservableFraction(run);
+    const auto& c = last->calibration;
+    out << "calibration_unobservable_final";
+    bool none = true;
+    for (size_t i = 0; i < names.size() && i < c.unobservable.size(); ++i) {
+      if (!c.unobservable[i]) continue;
+      out << ' ' << names[i];
+      none = false;
+    }
+    out << (none ? " -\n" : "\n") << "calibration_information_final";
+    for (size_t i = 0; i < names.size() && i < c.observability.size(); ++i) {
+      out << ' ' << names[i] << '=' << c.observability[i];
+    }
+    out << "\ncalibration_unobservable_fraction";
+    for (size_t i = 0; i < names.size() && i < fraction.size(); ++i) {
+      out << ' ' << names[i] << '=' << fraction[i];
+    }
+    out << "\n";
   }
-  out << (none ? " -\n" : "\n") << "calibration_information_final";
-  for (size_t i = 0; i < names.size() && i < c.observability.size(); ++i) {
-    out << ' ' << names[i] << '=' << c.observability[i];
-  }
-  out << "\ncalibration_unobservable_fraction";
-  for (size_t i = 0; i < names.size() && i < fraction.size(); ++i) {
-    out << ' ' << names[i] << '=' << fraction[i];
-  }
-  out << "\ncalibration_kept_at_start";
+  out << "calibration_kept_at_start";
   if (!recommended || recommended->kept_at_start.empty()) {
     out << " -";
   }
@@ -73,7 +103,8 @@ void WriteObservabilitySummary(const RunSummary& run,
 }
 
 std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
-                                                           bool keep_unobservable_at_start) {
+                                                           const lio::CalibrationOptions& options,
+                                                           bool keep_uninformed_at_start) {
   const lio::ScanResult* last = LastCalibration(run);
   if (last == nullptr) {
     return std::nullopt;
@@ -84,31 +115,53 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
   r.has_extrinsic = c.has_extrinsic;
   r.T_imu_lidar = c.has_extrinsic ? c.T_imu_lidar : run.initial_extrinsic;
   // calibration.csv's coordinates: T = Exp([ρ; φ])·T_start (PoseManifold's left tangent).
-  r.extrinsic_from_start = (r.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
-  const std::vector<double> fraction =
-      keep_unobservable_at_start ? UnobservableFraction(run) : std::vector<double>();
+  const Vec6 moved = (r.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
+  r.extrinsic_from_start = moved;
+  const std::vector<double> fraction = UnobservableFraction(run);
   const std::vector<std::string> names = CalibrationCoordinates(c);
-  if (fraction.size() != names.size()) {
-    return r;  // not assessed (the check off)
-  }
-  const auto keep = [&](size_t i) {
-    if (!(fraction[i] > kKeepAtStartUnobservableFraction)) {
-      return false;
+  // Coordinate i: the estimate where its σ is below `threshold`, else the start; false: start.
+  const auto choose = [&](size_t i, double estimate, double sigma, double start, double threshold) {
+    CoordinateChoice k;
+    k.name = names[i];
+    k.estimate = estimate;
+    k.sigma = sigma;
+    k.start = start;
+    k.threshold = threshold;
+    if (i < fraction.size()) k.unobservable_fraction = fraction[i];
+    // σ = 0 is what a scan without a covariance reports (a failed one): no σ, not a certain one.
+    const bool has_sigma = std::isfinite(sigma) && sigma > 0.0;
+    if (!keep_uninformed_at_start) {
+      k.estimate_written = true;
+      k.reason = "the estimate, as asked (--calibration_keep_unobservable=false)";
+    } else if (!has_sigma) {
+      k.reason = "the start: the run reported no sigma for it (a failed covariance)";
+    } else if (sigma < threshold) {
+      k.estimate_written = true;
+      k.reason = "the estimate: sigma below the threshold, " + Threshold(k.name, threshold);
+    } else {
+      k.reason = "the start: sigma not below the threshold, " + Threshold(k.name, threshold) +
+                 ": the data did not inform it";
     }
-    r.kept_at_start.push_back(names[i]);
-    return true;
+    k.written = k.estimate_written ? estimate : start;
+    if (!k.estimate_written) r.kept_at_start.push_back(k.name);
+    r.coordinates.push_back(k);
+    return k.estimate_written;
   };
   const size_t imus = r.time_offset_s.size();
   for (size_t j = 0; j < imus; ++j) {
-    if (keep(j)) {
-      r.time_offset_s[j] = j < run.initial_time_offsets.size() ? run.initial_time_offsets[j] : 0.0;
+    const double start = j < run.initial_time_offsets.size() ? run.initial_time_offsets[j] : 0.0;
+    const double sigma = j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN;
+    if (!choose(j, c.time_offset_s[j], sigma, start, options.write_max_sigma_s)) {
+      r.time_offset_s[j] = start;
     }
   }
   if (r.has_extrinsic) {
     bool any = false;
-    for (size_t i = 0; i < 6; ++i) {
-      if (keep(imus + i)) {
-        r.extrinsic_from_start[static_cast<int>(i)] = 0.0;
+    for (int i = 0; i < 6; ++i) {
+      const double threshold =
+          i < 3 ? options.write_max_sigma_m : M_PI / 180.0 * options.write_max_sigma_deg;
+      if (!choose(imus + static_cast<size_t>(i), moved[i], c.extrinsic_sigma[i], 0.0, threshold)) {
+        r.extrinsic_from_start[i] = 0.0;
         any = true;
       }
     }
@@ -224,81 +277,79 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
     return false;
   }
   const auto& c = last->calibration;
-  const std::vector<std::string> names = CalibrationCoordinates(c);
-  const std::vector<double> fraction = UnobservableFraction(run);
   std::ofstream f = io::OpenForWriting(path);
-  f << std::setprecision(9);
+  f << std::setprecision(6);
   f << "# Online calibration of " << run.method << " on " << run.source << " after "
     << 1e-9 * static_cast<double>(last->t_ns - run.scans.front().t_ns) << " s.\n"
-    << "# Paste into the odometry config (docs/user-guide/calibration.md).\n";
-  if (!recommended.kept_at_start.empty()) {
-    f << "# NOT CALIBRATED (unobservable after more than "
-      << 100.0 * kKeepAtStartUnobservableFraction
-      << "% of the scans: the motion did not excite them), kept at the value the run started "
-         "from:";
-    for (const std::string& name : recommended.kept_at_start) {
-      const auto at = std::find(names.begin(), names.end(), name) - names.begin();
-      f << ' ' << name << " (" << std::lround(100.0 * fraction[static_cast<size_t>(at)]) << "%)";
-    }
-    f << ".\n# Calibrate them on a recording that rotates about every axis "
-         "(docs/user-guide/calibration.md).\n";
+    << "# Use it after the config the run used, --config my.yaml,calibration.yaml (later files\n"
+    << "# win key by key), or paste the keys at the end into that config\n"
+    << "# (docs/user-guide/calibration.md).\n#\n"
+    << "# Per coordinate, top-down: the run's last estimate, its marginal sigma, the value the "
+       "run\n"
+    << "# started from, the value written below and why. The estimate is written where its sigma\n"
+    << "# is below the threshold of its kind (calibration.write_max_sigma_s, _deg, _m), else the\n"
+    << "# start is kept: the data did not inform it.\n";
+  if (c.has_extrinsic) {
+    f << "# The extrinsic's coordinates are [rho; phi] of T_imu_lidar = Exp([rho; phi]) * T_start\n"
+      << "# (calibration.csv's), so its start is 0.\n";
   }
-  for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
-    f << "# IMU " << j << ": time offset estimate " << 1e3 * c.time_offset_s[j] << " ms, sigma "
-      << (j < c.time_offset_sigma_s.size() ? 1e3 * c.time_offset_sigma_s[j] : NAN) << " ms";
-    if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
-      f << ", truth " << 1e3 * *run.true_time_offsets[j] << " ms, error "
-        << 1e3 * (c.time_offset_s[j] - *run.true_time_offsets[j]) << " ms";
-    }
-    if (recommended.time_offset_s[j] != c.time_offset_s[j]) {
-      f << "; written: " << 1e3 * recommended.time_offset_s[j] << " ms (the start)";
-    }
-    f << "\n";
+  // The truth per coordinate where the source knows it (simulator), in the coordinates' units.
+  const size_t imus = c.time_offset_s.size();
+  std::optional<Vec6> true_extrinsic;
+  if (run.true_extrinsic) {
+    true_extrinsic = (*run.true_extrinsic * run.initial_extrinsic.Inverse()).Log();
   }
-  if (!c.time_offset_s.empty()) {
+  const auto truth = [&](size_t i) -> std::optional<double> {
+    if (i < imus) {
+      return i < run.true_time_offsets.size() ? run.true_time_offsets[i] : std::nullopt;
+    }
+    if (true_extrinsic) return (*true_extrinsic)[static_cast<int>(i - imus)];
+    return std::nullopt;
+  };
+  for (size_t i = 0; i < recommended.coordinates.size(); ++i) {
+    const CoordinateChoice& k = recommended.coordinates[i];
+    const Unit u = DisplayUnit(k.name);
+    f << "#\n# " << k.name << " [" << u.name << "]\n"
+      << "#   estimate   " << u.scale * k.estimate << "\n"
+      << "#   sigma      " << u.scale * k.sigma << "\n"
+      << "#   start      " << u.scale * k.start << "\n"
+      << "#   written    " << u.scale * k.written << "\n"
+      << "#   why        " << k.reason << "\n";
+    if (const auto t = truth(i)) {
+      f << "#   truth      " << u.scale * *t << " (the written value is off by "
+        << u.scale * (k.written - *t) << ")\n";
+    }
+    if (k.unobservable_fraction >= 0.0) {
+      f << "#   flagged unobservable after " << std::lround(100.0 * k.unobservable_fraction)
+        << "% of the scans (information: the observability check)\n";
+    }
+  }
+  f << std::setprecision(9);
+  if (imus > 0) {
     f << "calibration:\n  time_offset_s: [";
     for (size_t j = 0; j < recommended.time_offset_s.size(); ++j) {
       f << (j > 0 ? ", " : "") << recommended.time_offset_s[j];
     }
     f << "]\n";
   }
-  io::CloseChecked(f, path);
-  if (!c.has_extrinsic) return true;
-  // The `extrinsic:` section (top level, beside `calibration:`), in the config's own keys.
-  std::ofstream e(path, std::ios::app);
-  const Vec6 d = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
-  const Vec6& s = c.extrinsic_sigma;
-  const double deg = 180.0 / M_PI;
-  e << std::setprecision(9) << "# Extrinsic T_imu_lidar estimate: moved by rho = [" << d[0] << ", "
-    << d[1] << ", " << d[2] << "] m, phi = [" << deg * d[3] << ", " << deg * d[4] << ", "
-    << deg * d[5] << "] deg from the start; sigma [" << s[0] << ", " << s[1] << ", " << s[2]
-    << "] m, [" << deg * s[3] << ", " << deg * s[4] << ", " << deg * s[5] << "] deg";
-  if (run.true_extrinsic) {
-    const Vec6 err = (c.T_imu_lidar * run.true_extrinsic->Inverse()).Log();
-    const Vec6 t = (*run.true_extrinsic * run.initial_extrinsic.Inverse()).Log();
-    e << "; error vs truth " << 100.0 * err.head<3>().norm() << " cm, "
-      << deg * err.tail<3>().norm() << " deg\n# Extrinsic truth from the start: rho = [" << t[0]
-      << ", " << t[1] << ", " << t[2] << "] m, phi = [" << deg * t[3] << ", " << deg * t[4] << ", "
-      << deg * t[5] << "] deg";
-  }
-  const SE3& T = recommended.T_imu_lidar;
-  const Vec6& w = recommended.extrinsic_from_start;
-  if (w != d) {
-    e << "\n# Written (the unobservable axes at the start): rho = [" << w[0] << ", " << w[1] << ", "
-      << w[2] << "] m, phi = [" << deg * w[3] << ", " << deg * w[4] << ", " << deg * w[5]
-      << "] deg from the start";
+  if (c.has_extrinsic) {
+    // The `extrinsic:` section (top level, beside `calibration:`), in the config's own keys:
+    // rotation and translation, which win over an xyz_rpy of the config it is put after.
+    const SE3& T = recommended.T_imu_lidar;
     if (run.true_extrinsic) {
       const Vec6 err = (T * run.true_extrinsic->Inverse()).Log();
-      e << "; error vs truth " << 100.0 * err.head<3>().norm() << " cm, "
-        << deg * err.tail<3>().norm() << " deg";
+      f << std::setprecision(3) << "# The extrinsic written is off the truth by "
+        << 100.0 * err.head<3>().norm() << " cm, " << 180.0 / M_PI * err.tail<3>().norm()
+        << " deg.\n"
+        << std::setprecision(9);
     }
+    f << "extrinsic:\n  rotation: [";
+    const Mat3 R = T.rotation();
+    for (int i = 0; i < 9; ++i) f << (i > 0 ? ", " : "") << R(i / 3, i % 3);
+    const Vec3 p = T.translation();
+    f << "]\n  translation: [" << p.x() << ", " << p.y() << ", " << p.z() << "]\n";
   }
-  e << "\nextrinsic:\n  rotation: [";
-  const Mat3 R = T.rotation();
-  for (int i = 0; i < 9; ++i) e << (i > 0 ? ", " : "") << R(i / 3, i % 3);
-  const Vec3 p = T.translation();
-  e << "]\n  translation: [" << p.x() << ", " << p.y() << ", " << p.z() << "]\n";
-  io::CloseChecked(e, path);
+  io::CloseChecked(f, path);
   return true;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/solvers/lio/calibration_options.h"
 #include "lio/run_odometry.h"
 
 namespace ctlio::lioapp {
@@ -39,39 +40,55 @@ std::vector<double> UnobservableFraction(const RunSummary& run);
 void WriteCalibrationLog(const std::string& path, const RunSummary& run,
                          const std::vector<lio::ScanResult>* scans = nullptr);
 
-// A coordinate unobservable after more than this fraction of the assessed scans was never
-// calibrated by the run: its estimate is wherever the trajectory's errors pushed it (slow regime:
-// tens of degrees and centimetres from both the start and the truth, docs/experiments/
-// calibration.md), so the values recommended for a config keep the start along it.
-inline constexpr double kKeepAtStartUnobservableFraction = 0.5;
+// One calibration coordinate of what a run recommends writing: its estimate, σ and start, the
+// value written and why. Units: δ in s; the extrinsic's ρ in m and φ in rad, as the left-tangent
+// components of Log(T·T_start⁻¹) (calibration.csv's coordinates), so its start is 0.
+struct CoordinateChoice {
+  std::string name;        // CalibrationCoordinates
+  double estimate = 0.0;   // the last estimate
+  double sigma = 0.0;      // its marginal σ (NaN: none reported)
+  double start = 0.0;      // the value the run started from
+  double threshold = 0.0;  // calibration.write_max_sigma_* of its kind, same unit
+  bool estimate_written = false;
+  double written = 0.0;                 // estimate or start
+  std::string reason;                   // why that one, for a person
+  double unobservable_fraction = -1.0;  // of the assessed scans (< 0: not assessed); information
+};
 
-// The calibration a run recommends pasting into a config: the last estimate, except that with
-// `keep_unobservable_at_start` every coordinate unobservable after more than
-// kKeepAtStartUnobservableFraction of the assessed scans keeps the value the run started from
-// (δ_j: run.initial_time_offsets; the extrinsic's ρ / φ: the left-tangent components of
-// Log(T·T_start⁻¹) set to zero, as calibration.csv's coordinates). Nothing without an estimate.
+// The calibration a run recommends using in a config: per coordinate the last estimate where
+// its marginal σ is below the threshold of its kind (options.write_max_sigma_s, _deg, _m), else
+// the value the run started from (δ_j: run.initial_time_offsets; the extrinsic's ρ / φ set to
+// zero), because a σ that large says the data did not inform it. The share of scans on which the
+// observability check flagged a coordinate does not decide (issue 45: an offset estimated
+// 20.045 ± 0.20 ms, flagged on 81% of the scans, is a calibration); it is kept as information.
+// `keep_uninformed_at_start` false writes every estimate. Nothing without an estimate.
 struct RecommendedCalibration {
   std::vector<double> time_offset_s;  // per IMU [s]
   bool has_extrinsic = false;
   SE3 T_imu_lidar;
-  Vec6 extrinsic_from_start = Vec6::Zero();  // [ρ; φ] of T_imu_lidar from the start, kept axes 0
-  std::vector<std::string> kept_at_start;    // coordinate names (CalibrationCoordinates)
+  Vec6 extrinsic_from_start = Vec6::Zero();   // [ρ; φ] of T_imu_lidar from the start, kept axes 0
+  std::vector<std::string> kept_at_start;     // coordinate names (CalibrationCoordinates)
+  std::vector<CoordinateChoice> coordinates;  // every coordinate, in CalibrationCoordinates order
 };
 std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run,
-                                                           bool keep_unobservable_at_start = true);
+                                                           const lio::CalibrationOptions& options,
+                                                           bool keep_uninformed_at_start = true);
 
 // Run summary lines (evaluation.txt): calibration_unobservable_final (the coordinates
 // unobservable after the last scan, or -), calibration_information_final (ν per coordinate),
-// calibration_unobservable_fraction (per coordinate, of the assessed scans) and
-// calibration_kept_at_start (`recommended`'s, or -). Nothing without the observability check.
+// calibration_unobservable_fraction (per coordinate, of the assessed scans), with the
+// observability check only; calibration_kept_at_start (`recommended`'s, or -) with a calibration.
 void WriteObservabilitySummary(const RunSummary& run,
                                const std::optional<RecommendedCalibration>& recommended,
                                std::ostream& out);
 
-// `recommended` (RecommendCalibration of `run`; and the last estimate, σ and the truth where the
-// source knows it, as comments) as a `calibration:` mapping with time_offset_s and, with the
-// extrinsic estimated, an `extrinsic:` section; a comment names every coordinate kept at its
-// start. False (nothing written) without an estimate.
+// `recommended` (RecommendCalibration of `run`) as calibration.yaml: a header saying how to use
+// it and the rule, then per coordinate one comment block read top-down — estimate, σ, start,
+// written value and why (and, where the source knows it, the truth; with the observability
+// check, the share of scans it flagged) — then the keys: `calibration: {time_offset_s}` and,
+// with the extrinsic estimated, an `extrinsic:` section (rotation, translation), so that the file
+// is also an overlay (--config my.yaml,calibration.yaml). False (nothing written) without an
+// estimate.
 bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
                           const RecommendedCalibration& recommended);
 

@@ -2,36 +2,34 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <filesystem>
+#include <exception>
+#include <vector>
+
+#include "ctlio/solvers/lio/config_composition.h"
 
 namespace ctlio::lioapp {
 
-std::string DescribeConfig(const std::string& path) {
-  if (path.empty()) {
+std::string DescribeConfig(const std::string& spec) {
+  if (spec.empty()) {
     return "built-in defaults (no --config)";
   }
-  std::string text = path;
-  std::string file = path;
-  // LoadOdometryYaml allows 8 files in a chain; the bound also stops a cycle here.
-  for (int depth = 0; depth < 8; ++depth) {
-    YAML::Node root;
-    try {
-      root = YAML::LoadFile(file);
-    } catch (const std::exception&) {
-      break;
-    }
-    const YAML::Node& read = root;  // a non-const operator[] would add the key
-    if (!read.IsMap() || !read["base"] || !read["base"].IsScalar()) {
-      break;
-    }
-    std::filesystem::path base(read["base"].Scalar());
-    if (base.is_relative()) {
-      base = std::filesystem::path(file).parent_path() / base;
-    }
-    file = base.lexically_normal().string();
-    text += (depth == 0 ? " (extends " : ", which extends ") + file;
+  std::vector<lio::ComposedFile> files;
+  try {
+    lio::ComposeOdometryYaml(lio::SplitConfigList(spec), &files);
+  } catch (const std::exception&) {
+    return spec;
   }
-  return file == path ? text : text + ")";
+  if (files.size() == 1) {
+    return files.front().path;
+  }
+  std::string text;
+  for (const lio::ComposedFile& f : files) {
+    text += (text.empty() ? "" : ", ") + f.path;
+    if (!f.base_of.empty()) {
+      text += " (base of " + f.base_of + ")";
+    }
+  }
+  return text + "; later files win key by key";
 }
 
 }  // namespace ctlio::lioapp

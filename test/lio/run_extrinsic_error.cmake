@@ -16,7 +16,8 @@ if(at_size LESS 0 OR at_initial LESS 0)
   message(FATAL_ERROR "data/sim_lio.yaml: no lidar_frontend voxel_size / initial_voxel_size to set")
 endif()
 file(WRITE ${OUT}/reduced.yaml "${base}")
-file(WRITE ${OUT}/calibration.yaml "${base}\ncalibration:\n  estimate_extrinsic: true\n")
+# The calibrated run composes its config on the command line: reduced.yaml, then an overlay.
+file(WRITE ${OUT}/estimate_extrinsic.yaml "calibration:\n  estimate_extrinsic: true\n")
 
 # Singer-LIO on the tiny sequence with the 3° / 10 cm nominal extrinsic, config `config`, into
 # ${OUT}/${mode}; a failure stops the test with the program's output.
@@ -29,14 +30,23 @@ function(run_odometry mode config)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "ctlio_odometry (${mode}) failed (${rc}):\n${out}\n${err}")
   endif()
+  file(WRITE ${OUT}/${mode}.stdout "${out}")
 endfunction()
 
 foreach(mode fixed calibrated)
   set(config ${OUT}/reduced.yaml)
   if(mode STREQUAL "calibrated")
-    set(config ${OUT}/calibration.yaml)
+    set(config ${OUT}/reduced.yaml,${OUT}/estimate_extrinsic.yaml)
   endif()
   run_odometry(${mode} ${config})
+  if(mode STREQUAL "calibrated")  # the run names every file of its config
+    file(READ ${OUT}/${mode}.stdout printed)
+    string(FIND "${printed}"
+           "config: ${OUT}/reduced.yaml, ${OUT}/estimate_extrinsic.yaml; later files win" at)
+    if(at EQUAL -1)
+      message(FATAL_ERROR "the config line does not list both files:\n${printed}")
+    endif()
+  endif()
   file(READ ${OUT}/${mode}/evaluation.txt ev)
   set(expected "extrinsic_initial_error_deg 3\n" "extrinsic_initial_error_cm 10\n")
   if(mode STREQUAL "fixed")
@@ -53,7 +63,8 @@ foreach(mode fixed calibrated)
     endif()
   endforeach()
   # With calibration: the per-scan log has the extrinsic's columns and calibration.yaml a
-  # pasteable extrinsic: section and the truth's comment (which the plot reads); without, neither.
+  # pasteable extrinsic: section and a block per coordinate with the truth (which the plot
+  # reads); without, neither.
   if(mode STREQUAL "calibrated")
     file(STRINGS ${OUT}/${mode}/calibration.csv rows)
     list(GET rows 0 header)
@@ -69,7 +80,8 @@ foreach(mode fixed calibrated)
       message(FATAL_ERROR "calibration.csv has ${n} lines, expected one per scan")
     endif()
     file(READ ${OUT}/${mode}/calibration.yaml yaml)
-    foreach(text "\nextrinsic:\n  rotation: [" "\n  translation: [" "# Extrinsic truth from the start")
+    foreach(text "\nextrinsic:\n  rotation: [" "\n  translation: [" "\n# extrinsic_rho_x [cm]\n"
+                 "\n#   truth      ")
       string(FIND "${yaml}" "${text}" at)
       if(at EQUAL -1)
         message(FATAL_ERROR "calibration.yaml lacks '${text}':\n${yaml}")
@@ -82,6 +94,15 @@ foreach(mode fixed calibrated)
     message(FATAL_ERROR "calibration.csv written without calibration")
   endif()
 endforeach()
+
+# The written calibration.yaml is an overlay: after reduced.yaml it gives the run its extrinsic
+# (here the start wherever sigma kept it), with no estimation.
+run_odometry(pasted ${OUT}/reduced.yaml,${OUT}/calibrated/calibration.yaml)
+file(READ ${OUT}/pasted/evaluation.txt ev)
+string(FIND "${ev}" "extrinsic_estimated 0\n" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "pasted: evaluation.txt lacks 'extrinsic_estimated 0':\n${ev}")
+endif()
 
 # With a warm-up replay (calibration.warmup_replay_s, 0.5 s here): calibration.csv holds the
 # replayed estimates of every scan, calibration_live.csv the ones returned live up to the replay

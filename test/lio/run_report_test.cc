@@ -109,19 +109,29 @@ TEST(ConfigOrigin, SaysWhenTheBuiltInDefaultsApply) {
   EXPECT_EQ(DescribeConfig(""), "built-in defaults (no --config)");
 }
 
-TEST(ConfigOrigin, NamesTheFilesAConfigExtends) {
+TEST(ConfigOrigin, NamesEveryFileOfTheComposition) {
   const std::string dir = testing::FreshTempDir("config_origin").string();
-  std::ofstream(dir + "/c.yaml") << "gravity_magnitude: 9.81\n";
+  std::ofstream(dir + "/c.yaml") << "imu: {gravity: 9.81}\n";
   std::ofstream(dir + "/b.yaml") << "base: c.yaml\n";
   std::ofstream(dir + "/a.yaml") << "base: " << dir << "/b.yaml\n";  // absolute works as well
-  std::ofstream(dir + "/plain.yaml") << "point_noise_sigma: 0.02\n";
+  std::ofstream(dir + "/plain.yaml") << "lidar_frontend: {point_noise_sigma: 0.02}\n";
+  std::ofstream(dir + "/bad.yaml") << "no_such_section: 1\n";
   EXPECT_EQ(DescribeConfig(dir + "/plain.yaml"), dir + "/plain.yaml");
-  EXPECT_EQ(DescribeConfig(dir + "/a.yaml"),
-            dir + "/a.yaml (extends " + dir + "/b.yaml, which extends " + dir + "/c.yaml)");
-  // The repository's calibration config extends the simulator config.
-  EXPECT_EQ(DescribeConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml"),
-            std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml (extends " +
-                CTLIO_SOURCE_DIR + "/data/sim_lio.yaml)");
+  EXPECT_EQ(DescribeConfig(dir + "/a.yaml"), dir + "/c.yaml (base of " + dir + "/b.yaml), " + dir +
+                                                 "/b.yaml (base of " + dir + "/a.yaml), " + dir +
+                                                 "/a.yaml; later files win key by key");
+  // A list on the command line: every file, in the order applied.
+  EXPECT_EQ(DescribeConfig(dir + "/plain.yaml," + dir + "/b.yaml"),
+            dir + "/plain.yaml, " + dir + "/c.yaml (base of " + dir + "/b.yaml), " + dir +
+                "/b.yaml; later files win key by key");
+  // A config that does not load (its error is the loader's to report): as given.
+  EXPECT_EQ(DescribeConfig(dir + "/bad.yaml"), dir + "/bad.yaml");
+  // The repository's calibration config: the simulator config and the calibration overlay.
+  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  EXPECT_EQ(DescribeConfig(data + "sim_lio_calibration.yaml"),
+            data + "sim_lio.yaml (base of " + data + "sim_lio_calibration.yaml), " + data +
+                "calibration.yaml (base of " + data + "sim_lio_calibration.yaml), " + data +
+                "sim_lio_calibration.yaml; later files win key by key");
 }
 
 }  // namespace

@@ -41,6 +41,9 @@ void CalibrationOptions::Validate() const {
               (warmup_replay_passes == 1 && !warmup_replay_hold && !warmup_replay_freeze),
           "calibration.warmup_replay_passes / warmup_replay_hold / warmup_replay_freeze need "
           "warmup_replay_s > 0");
+  for (double t : {write_max_sigma_s, write_max_sigma_deg, write_max_sigma_m}) {
+    require(std::isfinite(t) && t > 0, "calibration.write_max_sigma_* must be finite and > 0");
+  }
   require(!(warmup_replay_hold && warmup_replay_freeze),
           "calibration.warmup_replay_hold and warmup_replay_freeze: choose one for the last pass");
 }

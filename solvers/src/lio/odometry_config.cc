@@ -3,13 +3,12 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
 #include <stdexcept>
-#include <system_error>
 
+#include "ctlio/solvers/lio/config_composition.h"
 #include "ctlio/solvers/lio/yaml_io.h"
 
 namespace ctlio::lio {
@@ -40,6 +39,18 @@ Setter FiniteExtrinsic(const std::string& source, const std::string& key, Setter
                                  ": an extrinsic must be finite");
       }
     }
+  };
+}
+
+// A threshold: finite and > 0, else an error naming the file, the line and the key.
+Setter SetPositive(double* field, const std::string& source, const std::string& key) {
+  return [=](const YAML::Node& v) {
+    const double x = v.as<double>();
+    if (!(std::isfinite(x) && x > 0)) {
+      throw std::runtime_error(YamlWhere(source, v.Mark()) + ": " + key + " = " + v.Scalar() +
+                               " must be finite and > 0");
+    }
+    *field = x;
   };
 }
 
@@ -162,6 +173,10 @@ struct TopLevel {
   bool have_extrinsic = false;
   Vec6 extrinsic_xyz_rpy = Vec6::Zero();
   std::vector<double> extrinsic_rotation;  // optional 3×3 row-major
+  // `translation`, which wins over xyz_rpy's first three whatever the key order: in a composed
+  // config (a calibration.yaml over a config with xyz_rpy) the later file's key comes last or
+  // in the earlier file's place.
+  std::vector<double> extrinsic_translation;
   YAML::Node per_method;
   YAML::Node imus;
 };
@@ -244,7 +259,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                     FiniteExtrinsic(source, "extrinsic.translation", [top](const YAML::Node& n) {
                       const auto t = n.as<std::vector<double>>();
                       if (t.size() != 3) throw YAML::Exception(n.Mark(), "need 3 numbers");
-                      top->extrinsic_xyz_rpy.head<3>() = Vec3(t[0], t[1], t[2]);
+                      top->extrinsic_translation = t;
                     })}});
     } else if (key == "degeneracy") {
       ReadSection(v, section, source,
@@ -274,7 +289,13 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"warmup_replay_s", SetFromYaml(&o.warmup_replay_s)},
            {"warmup_replay_passes", SetFromYaml(&o.warmup_replay_passes)},
            {"warmup_replay_hold", SetFromYaml(&o.warmup_replay_hold)},
-           {"warmup_replay_freeze", SetFromYaml(&o.warmup_replay_freeze)}});
+           {"warmup_replay_freeze", SetFromYaml(&o.warmup_replay_freeze)},
+           {"write_max_sigma_s",
+            SetPositive(&o.write_max_sigma_s, source, section + ".write_max_sigma_s")},
+           {"write_max_sigma_deg",
+            SetPositive(&o.write_max_sigma_deg, source, section + ".write_max_sigma_deg")},
+           {"write_max_sigma_m",
+            SetPositive(&o.write_max_sigma_m, source, section + ".write_max_sigma_m")}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {
@@ -348,7 +369,11 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
            Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
               .toRotationMatrix();
     }
-    c.T_imu_lidar = SE3(C, top.extrinsic_xyz_rpy.head<3>());
+    const Vec3 p = top.extrinsic_translation.empty()
+                       ? Vec3(top.extrinsic_xyz_rpy.head<3>())
+                       : Vec3(top.extrinsic_translation[0], top.extrinsic_translation[1],
+                              top.extrinsic_translation[2]);
+    c.T_imu_lidar = SE3(C, p);
   }
   if (top.imus) {
     for (size_t j = 0; j < top.imus.size(); ++j) {
@@ -401,70 +426,13 @@ OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string&
   return c;
 }
 
-namespace {
-
-// `over`'s keys onto the mapping `base`: mappings key by key, anything else replaced. The nodes
-// are shared, not copied, so that they keep their line numbers for error messages.
-void OverlayYaml(YAML::Node base, const YAML::Node& over) {
-  for (const auto& kv : over) {
-    const std::string key = kv.first.Scalar();
-    YAML::Node existing = base[key];
-    if (existing.IsMap() && kv.second.IsMap()) {
-      OverlayYaml(existing, kv.second);
-    } else {
-      base[key] = kv.second;
-    }
-  }
+YAML::Node LoadOdometryYaml(const std::string& path) {
+  return ComposeOdometryYaml(SplitConfigList(path));
 }
-
-constexpr int kMaxBaseChain = 8;
-
-YAML::Node LoadOdometryYamlChain(const std::string& path, int depth) {
-  YAML::Node root = LoadYamlFile(path, "odometry config");
-  const YAML::Node& read = root;  // a non-const operator[] would add the key it looks up
-  if (!read.IsMap() || !read["base"]) {
-    return root;
-  }
-  const YAML::Node base_key = read["base"];
-  const std::string where = YamlWhere(path, base_key.Mark()) + ": base: ";
-  if (!base_key.IsScalar() || base_key.Scalar().empty()) {
-    throw std::runtime_error(where + "must be the path of the config this one extends");
-  }
-  if (depth + 1 >= kMaxBaseChain) {
-    throw std::runtime_error(where + "more than " + std::to_string(kMaxBaseChain) +
-                             " files extend each other (a cycle?)");
-  }
-  std::filesystem::path base_path(base_key.Scalar());
-  if (base_path.is_relative()) {
-    base_path = std::filesystem::path(path).parent_path() / base_path;
-  }
-  // A device or a folder named as the base would block or fail obscurely in the parser.
-  std::error_code error;
-  if (std::filesystem::exists(base_path, error) &&
-      !std::filesystem::is_regular_file(base_path, error)) {
-    throw std::runtime_error(where + base_path.string() + " is not a regular file");
-  }
-  YAML::Node merged;
-  try {
-    merged = LoadOdometryYamlChain(base_path.string(), depth + 1);
-    OdometryConfigFromYaml(merged, base_path.string());
-  } catch (const std::exception& e) {
-    throw std::runtime_error(where + e.what());
-  }
-  if (!merged.IsMap()) {
-    merged = YAML::Node(YAML::NodeType::Map);  // an empty base
-  }
-  root.remove("base");
-  OverlayYaml(merged, root);
-  return merged;
-}
-
-}  // namespace
-
-YAML::Node LoadOdometryYaml(const std::string& path) { return LoadOdometryYamlChain(path, 0); }
 
 OdometryConfig LoadOdometryConfig(const std::string& path) {
-  return OdometryConfigFromYaml(LoadOdometryYaml(path), path);
+  const std::vector<std::string> files = SplitConfigList(path);
+  return OdometryConfigFromYaml(ComposeOdometryYaml(files), files.back());
 }
 
 }  // namespace ctlio::lio

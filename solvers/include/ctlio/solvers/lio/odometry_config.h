@@ -182,17 +182,17 @@ struct OdometryConfig {
 //   per_method:
 //     imu_input: {lidar_frontend: {max_iterations: 5}}
 OdometryConfig OdometryConfigFromYaml(const YAML::Node& root, const std::string& source);
-// Reads an odometry config file (LoadOdometryYaml) and converts it.
+// Reads an odometry config file or composition (LoadOdometryYaml) and converts it.
 OdometryConfig LoadOdometryConfig(const std::string& path);
 
-// Reads an odometry config file as YAML. A top-level `base: PATH` (relative to the file's folder)
-// makes the file extend another: the base is read (and checked on its own, so that its errors name
-// its own file and line), then this file's keys replace the base's mapping by mapping — a key
-// inside a section replaces that key only, a value or a list replaces the whole value — and the
-// result has no `base` key. Bases may chain, up to 8 files (a cycle is reported as too deep); a
-// base must be a regular file (a device or a folder is refused before it is read).
-// Without `base` the file's YAML is returned as read. data/sim_lio_calibration.yaml extends
-// data/sim_lio.yaml this way.
+// Reads an odometry config as YAML: one file, or a comma-separated list "a.yaml,b.yaml" whose later
+// files win key by key (config_composition.h). A top-level `base: PATH` or `base: [PATH, ...]`
+// (relative to the file's folder) makes a file extend others the same way: the bases are read and
+// checked first (their errors name their own file and line), then the file's keys replace theirs
+// mapping by mapping — a key inside a section replaces that key only, a value or a list replaces
+// the whole value — and the result has no `base` key. Up to 8 files deep (a cycle is reported as
+// too deep); a base must be a regular file. data/sim_lio_calibration.yaml is data/sim_lio.yaml
+// with the overlay data/calibration.yaml this way.
 YAML::Node LoadOdometryYaml(const std::string& path);
 
 // --- Pipeline input (what a dataset reader or the simulator hands over, converted by the app).
