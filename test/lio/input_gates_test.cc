@@ -340,5 +340,39 @@ TEST(InputGates, RunWithoutEstimatesFailsWithoutAte) {
   if (deg_run.trajectory.size() < 3) EXPECT_FALSE(deg_run.ate);
 }
 
+// Issue 40: too few IMU samples for the gravity initialisation is named as a rate (or a late
+// start), not as "accelerometer units or axes" or a platform that is not still.
+TEST(InputGates, TooFewImuSamplesForGravityNameTheRateNotTheUnits) {
+  struct Case {
+    double rate_hz, clock_offset_s;
+    std::string expected;
+  };
+  for (const Case& k :
+       {Case{20.0, 0.0, "the IMU rate (about 20 Hz) is too low"},
+        Case{10.0, 0.0, "the IMU rate is too low (a single sample"},
+        Case{200.0, 0.08, "the IMU starts only 0.0196 s before the first scan end"}}) {
+    for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+      SCOPED_TRACE(k.expected);
+      sim::SimConfig sc = Tiny(0.5);
+      sc.imu.rate_hz = k.rate_hz;
+      sc.imu.clock_offset_s = k.clock_offset_s;
+      sim::SimulatedSource source(sc);
+      OdometryConfig c = Config();
+      c.method = m;
+      c.T_imu_lidar = source.ImuFromLidar();
+      LioOdometry odometry(c);
+      io::ScanFrame f;
+      ASSERT_TRUE(source.Next(&f));
+      for (const ImuSample& s : f.imu) odometry.AddImu(s);
+      LidarScan scan = lioapp::TakeLidarScan(&f);
+      const ScanResult r = odometry.AddScan(scan);
+      EXPECT_EQ(r.status, ScanStatus::kFailed);
+      EXPECT_THAT(r.message, HasSubstr(k.expected));
+      EXPECT_THAT(r.message, ::testing::Not(HasSubstr("units")));
+      EXPECT_THAT(r.message, ::testing::Not(HasSubstr("not still")));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio
