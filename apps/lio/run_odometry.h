@@ -52,6 +52,9 @@ struct RunSummary {
   std::string method;
   std::string source;
   std::string extrinsic_origin;  // where T_imu_lidar came from
+  // A config extrinsic that differs from the data's (/tf_static, preset, dataset) by more than 1°
+  // or 1 cm: "config vs <origin>: 12.3 deg, 4.5 cm (…)", both values (extrinsic_agreement.h).
+  std::string extrinsic_disagreement;
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
   // estimated (failed scans are left out, never written as garbage); with the extrinsic
   // estimated online (calibration.estimate_extrinsic), T_mr·T_imu_lidar of that scan's estimate.

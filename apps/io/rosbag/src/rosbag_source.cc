@@ -257,6 +257,19 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     } else if (s.preset) {
       s.extrinsic = s.preset->imu_from_lidar;
       s.extrinsic_origin = "the " + s.preset->name + " preset";
+      if (!edges.empty()) {
+        // The bag carries a tree, but not between these frames: the preset (recognised from the
+        // topic names unless --preset) is a guess that the bag is the preset's sensor (issue 40).
+        auto frame = [](const std::string& f) {
+          return f.empty() ? "(no frame_id)" : "'" + f + "'";
+        };
+        std::string why = " — a guess: the bag's /tf_static does not connect the IMU frame " +
+                          frame(s.imu_frame) + " and the lidar frame " + frame(s.lidar_frame);
+        if (options.preset.empty()) why = " (recognised from the topic names)" + why;
+        s.extrinsic_origin += why;
+        LOG(WARNING) << path << ": T_imu_lidar from " << s.extrinsic_origin
+                     << "; give `extrinsic:` in the config if the bag is another sensor's";
+      }
     } else if (!s.lidar_frame.empty() && s.lidar_frame == s.imu_frame) {
       s.extrinsic_origin = "identity (lidar and IMU share frame_id '" + s.lidar_frame + "')";
     }
