@@ -25,6 +25,8 @@
 #include "ctlio/io/point_time_check.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/rosbag_source.h"
+#include "ctlio/io/sim_folder.h"
+#include "ctlio/sim/lidar_inertial_sim.h"
 
 namespace ctlio::io {
 namespace {
@@ -430,6 +432,51 @@ TEST(PointTimeNewerCollege, TimesThatCannotBeASweepAreRescaledOrRecoveredFromThe
     ASSERT_EQ(frames.size(), 3u);
     ExpectSweeps(frames, kPoints);
     EXPECT_TRUE(sink.Has("cloud_1_000000000.pcd: ")) << c.label;
+    EXPECT_TRUE(sink.Has(c.warning)) << c.label;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// ctlio layout (ctlio's own writer; the interval is in scans.csv): the same rule, scan 1 edited.
+
+TEST(PointTimeCtlioLayout, TimesThatCannotBeASweepAreRescaledOrRecoveredFromTheAzimuth) {
+  sim::SimConfig config = sim::ExperimentConfig(sim::Regime::kMedium, 1);
+  config.duration_s = 0.3;
+  config.lidar.beams = 16;
+  config.lidar.firing_decimation = 8;
+  struct Case {
+    std::string label;
+    std::function<int64_t(int64_t offset)> edit;  // the stored offset [ns] from the true one
+    std::string warning;
+  };
+  const std::vector<Case> cases = {
+      {"microseconds", [](int64_t o) { return o / 1000; }, "unit factor 1000"},
+      {"at_stamp", [](int64_t) { return int64_t{0}; }, "points at the scan stamp"},
+      {"mid_scan", [](int64_t) { return int64_t{50'000'000}; }, "points at one instant"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.label);
+    const fs::path d = testing::FreshTempDir("point_time_ctlio_" + c.label);
+    sim::SimulatedSource source(config);
+    WriteSimFolder(source, d.string());
+    const std::string bin = (d / "scans" / "000001.bin").string();
+    SimFolderReader clean(d.string());
+    const std::vector<ScanFrame> before = ReadAll(clean);
+    ASSERT_GE(before.size(), 2u);
+    PointCloud cloud = before[1].cloud;
+    ASSERT_GE(cloud.size(), kMinPointsForSpread);
+    for (int64_t& t : cloud.times_ns) t = cloud.stamp_ns + c.edit(t - cloud.stamp_ns);
+    WriteSimScan(bin, cloud);
+    WarningSink sink;
+    SimFolderReader r(d.string());
+    const std::vector<ScanFrame> after = ReadAll(r);
+    ASSERT_EQ(after.size(), before.size());
+    const auto [lo, hi] =
+        std::minmax_element(after[1].cloud.times_ns.begin(), after[1].cloud.times_ns.end());
+    const int64_t length = before[1].end_ns - before[1].start_ns;
+    EXPECT_GT(*hi - *lo, length / 2);  // a sweep again
+    EXPECT_EQ(after[1].cloud.size(), cloud.size());
+    EXPECT_TRUE(sink.Has("scans/000001.bin: ")) << c.label;
     EXPECT_TRUE(sink.Has(c.warning)) << c.label;
   }
 }
