@@ -336,6 +336,17 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
            io::FormatSecondsNs(previous_end) + " s");
       continue;
     }
+    if (have_previous && frame.start_ns < previous_end &&
+        previous_end - frame.start_ns > (frame.end_ns - frame.start_ns) / 10) {
+      const std::string m =
+          "scan " + std::to_string(frame.index) + ": its interval [" +
+          io::FormatSecondsNs(frame.start_ns) + ", " + io::FormatSecondsNs(frame.end_ns) +
+          "] s begins " + std::to_string(1e-9 * double(previous_end - frame.start_ns)) +
+          " s before the previous scan's end " + io::FormatSecondsNs(previous_end) +
+          " s: scan intervals overlap (wrong scan start/end times?)";
+      if (run.overlapping_scans++ < 5) warn(m);
+      if (run.first_overlapping_scan.empty()) run.first_overlapping_scan = m;
+    }
     if (options.play_rate > 0.0) {
       if (!pace_origin) pace_origin.emplace(std::chrono::steady_clock::now(), frame.end_ns);
       const double seconds = 1e-9 * double(frame.end_ns - pace_origin->second) / options.play_rate;

@@ -85,6 +85,12 @@ struct RunSummary {
   // lidar moved (status "suspect"; they make the run a failure); and the runner's own recovery:
   // scans skipped because their end is not after the previous one (the odometry would throw).
   int imu_rejected = 0, points_dropped = 0, scans_skipped = 0, constant_imu_scans = 0;
+  // Scans whose interval begins before the previous scan's end by more than 10 % of its length
+  // (scan times that overlap: a stretched or misplaced interval), counted and warned about by the
+  // runner: what follows from them (a failed gravity initialisation, points dropped out of the
+  // interval) names its own symptom, not this cause.
+  int overlapping_scans = 0;
+  std::string first_overlapping_scan;                  // the first one's warning
   std::string first_input_warning;                     // message of the first of the above
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
   double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan

@@ -19,6 +19,7 @@ namespace ctlio::lio {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 TEST(InputChecks, ImuRangeAndGravityMagnitude) {
   InputCheckOptions o;
@@ -42,7 +43,15 @@ TEST(InputChecks, ImuRangeAndGravityMagnitude) {
   for (auto& x : still) x.accel /= 9.81;  // accelerometer in g
   ASSERT_TRUE(CheckGravityMagnitude(still, 9.81, 0.2));
   EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), HasSubstr("units"));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), HasSubstr("g, not m/s²"));
   EXPECT_TRUE(CheckGravityMagnitude({}, 9.81, 0.2));
+  // Issue 40: any other magnitude (19.5 m/s²: a window in motion, as when overlapping scan times
+  // put it there) names the motion first, not only the units.
+  for (auto& x : still) x.accel = Vec3(0.1, -0.2, 19.5);
+  ASSERT_TRUE(CheckGravityMagnitude(still, 9.81, 0.2));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2),
+              HasSubstr("the platform accelerates in the window"));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), Not(HasSubstr("g, not m/s²")));
 }
 
 TEST(InputChecks, ConstantImuScanTimesAndMotion) {
