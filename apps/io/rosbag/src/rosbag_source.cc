@@ -411,8 +411,20 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
       ++retimed_scans;
       const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
       if (warnings->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
-        LOG(WARNING) << where << "time field " << DescribeConvention(layout.convention) << ": "
-                     << check.reason
+        // An integer field of 8 or 16 bits cannot hold a sweep in ns (it wraps every 256 ns or
+        // 65.5 µs): the width is the likely cause, said with the field's type.
+        const size_t bytes = FieldDatatypeSize(layout.time->datatype);
+        const std::string narrow =
+            azimuth && bytes <= 2 && layout.time->datatype != kFloat32 &&
+                    layout.time->datatype != kFloat64
+                ? " (a " + FieldDatatypeName(layout.time->datatype) + " field holds at most " +
+                      std::to_string((1u << (8 * bytes - (layout.time->datatype == kInt8 ||
+                                                          layout.time->datatype == kInt16))) -
+                                     1) +
+                      " units: too narrow for a sweep)"
+                : "";
+        LOG(WARNING) << where << "time field " << DescribeConvention(layout.convention) << narrow
+                     << ": " << check.reason
                      << (azimuth ? "; times recovered from the azimuth instead" : "");
       }
       if (azimuth) {
