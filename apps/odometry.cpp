@@ -463,6 +463,13 @@ int main(int argc, char** argv) {
          << run.points_dropped << "\nscans_skipped " << run.scans_skipped << "\nconstant_imu_scans "
          << run.constant_imu_scans << "\nlidar_gaps " << run.lidar_gaps << "\n";
       if (run.lidar_gaps > 0) ev << "first_lidar_gap \"" << run.first_lidar_gap << "\"\n";
+      if (run.overlapping_scans > 0) {
+        ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
+           << run.first_overlapping_scan << "\"\n";
+      }
+      if (!run.extrinsic_disagreement.empty()) {
+        ev << "extrinsic_disagreement \"" << run.extrinsic_disagreement << "\"\n";
+      }
       // An estimate the lidar never fixed has no ATE; the line says why (run_checks.h).
       if (!run.unregistered_run.empty()) ev << "no_ate \"" << run.unregistered_run << "\"\n";
       if (!run.first_input_warning.empty()) {
@@ -651,6 +658,14 @@ int main(int argc, char** argv) {
       if (r.lidar_gaps > 0) {
         std::printf("  %-10s lidar: %d gap(s) over 3x the median scan period (first: %s)\n",
                     r.method.c_str(), r.lidar_gaps, r.first_lidar_gap.c_str());
+      }
+      if (r.overlapping_scans > 0) {
+        std::printf("  %-10s WARNING %d scan(s) begin before the previous scan's end (first: %s)\n",
+                    r.method.c_str(), r.overlapping_scans, r.first_overlapping_scan.c_str());
+      }
+      if (!r.extrinsic_disagreement.empty()) {
+        std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),
+                    r.extrinsic_disagreement.c_str());
       }
     }
     std::printf("\n");

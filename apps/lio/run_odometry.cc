@@ -19,6 +19,7 @@
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
+#include "extrinsic_agreement.h"
 #include "run_checks.h"
 
 namespace ctlio::lioapp {
@@ -241,6 +242,27 @@ lio::LidarScan TakeLidarScan(io::ScanFrame* frame) {
   return scan;
 }
 
+namespace {
+// The config's extrinsic against the data's own, when the data have one (a source without one
+// throws from ImuFromLidar: nothing to compare). Warned about here; the caller reports it.
+std::string CompareWithDataExtrinsic(io::DataSource& source, const SE3& config_T) {
+  std::string origin;
+  SE3 data_T;
+  try {
+    data_T = source.ImuFromLidar();
+    origin = source.ExtrinsicOrigin();
+  } catch (const std::exception&) {
+    return "";
+  }
+  const std::string d = ExtrinsicDisagreement(config_T, "config", data_T, origin);
+  if (!d.empty()) {
+    LOG(WARNING) << source.Name() << ": the config's extrinsic is used, but it disagrees with the "
+                 << "data's: " << d;
+  }
+  return d;
+}
+}  // namespace
+
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options, double failure_ate) {
   RunSummary run;
@@ -264,6 +286,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   }
   if (options.extrinsic_from_config) {
     run.extrinsic_origin = "the config (extrinsic:)";
+    run.extrinsic_disagreement = CompareWithDataExtrinsic(source, config.T_imu_lidar);
   } else {
     config.T_imu_lidar = source.ImuFromLidar();
     run.extrinsic_origin = source.ExtrinsicOrigin();
@@ -312,6 +335,17 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
            io::FormatSecondsNs(frame.end_ns) + " s is not after the previous scan's " +
            io::FormatSecondsNs(previous_end) + " s");
       continue;
+    }
+    if (have_previous && frame.start_ns < previous_end &&
+        previous_end - frame.start_ns > (frame.end_ns - frame.start_ns) / 10) {
+      const std::string m =
+          "scan " + std::to_string(frame.index) + ": its interval [" +
+          io::FormatSecondsNs(frame.start_ns) + ", " + io::FormatSecondsNs(frame.end_ns) +
+          "] s begins " + std::to_string(1e-9 * double(previous_end - frame.start_ns)) +
+          " s before the previous scan's end " + io::FormatSecondsNs(previous_end) +
+          " s: scan intervals overlap (wrong scan start/end times?)";
+      if (run.overlapping_scans++ < 5) warn(m);
+      if (run.first_overlapping_scan.empty()) run.first_overlapping_scan = m;
     }
     if (options.play_rate > 0.0) {
       if (!pace_origin) pace_origin.emplace(std::chrono::steady_clock::now(), frame.end_ns);

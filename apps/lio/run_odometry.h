@@ -52,6 +52,9 @@ struct RunSummary {
   std::string method;
   std::string source;
   std::string extrinsic_origin;  // where T_imu_lidar came from
+  // A config extrinsic that differs from the data's (/tf_static, preset, dataset) by more than 1°
+  // or 1 cm: "config vs <origin>: 12.3 deg, 4.5 cm (…)", both values (extrinsic_agreement.h).
+  std::string extrinsic_disagreement;
   // Estimated T_world_lidar (map frame = IMU frame at the start) at every scan end that was
   // estimated (failed scans are left out, never written as garbage); with the extrinsic
   // estimated online (calibration.estimate_extrinsic), T_mr·T_imu_lidar of that scan's estimate.
@@ -82,6 +85,12 @@ struct RunSummary {
   // lidar moved (status "suspect"; they make the run a failure); and the runner's own recovery:
   // scans skipped because their end is not after the previous one (the odometry would throw).
   int imu_rejected = 0, points_dropped = 0, scans_skipped = 0, constant_imu_scans = 0;
+  // Scans whose interval begins before the previous scan's end by more than 10 % of its length
+  // (scan times that overlap: a stretched or misplaced interval), counted and warned about by the
+  // runner: what follows from them (a failed gravity initialisation, points dropped out of the
+  // interval) names its own symptom, not this cause.
+  int overlapping_scans = 0;
+  std::string first_overlapping_scan;                  // the first one's warning
   std::string first_input_warning;                     // message of the first of the above
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
   double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan

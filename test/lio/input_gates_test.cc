@@ -19,6 +19,7 @@ namespace ctlio::lio {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 TEST(InputChecks, ImuRangeAndGravityMagnitude) {
   InputCheckOptions o;
@@ -42,7 +43,15 @@ TEST(InputChecks, ImuRangeAndGravityMagnitude) {
   for (auto& x : still) x.accel /= 9.81;  // accelerometer in g
   ASSERT_TRUE(CheckGravityMagnitude(still, 9.81, 0.2));
   EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), HasSubstr("units"));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), HasSubstr("g, not m/s²"));
   EXPECT_TRUE(CheckGravityMagnitude({}, 9.81, 0.2));
+  // Issue 40: any other magnitude (19.5 m/s²: a window in motion, as when overlapping scan times
+  // put it there) names the motion first, not only the units.
+  for (auto& x : still) x.accel = Vec3(0.1, -0.2, 19.5);
+  ASSERT_TRUE(CheckGravityMagnitude(still, 9.81, 0.2));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2),
+              HasSubstr("the platform accelerates in the window"));
+  EXPECT_THAT(*CheckGravityMagnitude(still, 9.81, 0.2), Not(HasSubstr("g, not m/s²")));
 }
 
 TEST(InputChecks, ConstantImuScanTimesAndMotion) {
@@ -338,6 +347,40 @@ TEST(InputGates, RunWithoutEstimatesFailsWithoutAte) {
   const lioapp::RunSummary deg_run = lioapp::RunOdometry(deg, Config());
   EXPECT_TRUE(deg_run.failure);
   if (deg_run.trajectory.size() < 3) EXPECT_FALSE(deg_run.ate);
+}
+
+// Issue 40: too few IMU samples for the gravity initialisation is named as a rate (or a late
+// start), not as "accelerometer units or axes" or a platform that is not still.
+TEST(InputGates, TooFewImuSamplesForGravityNameTheRateNotTheUnits) {
+  struct Case {
+    double rate_hz, clock_offset_s;
+    std::string expected;
+  };
+  for (const Case& k :
+       {Case{20.0, 0.0, "the IMU rate (about 20 Hz) is too low"},
+        Case{10.0, 0.0, "the IMU rate is too low (a single sample"},
+        Case{200.0, 0.08, "the IMU starts only 0.0196 s before the first scan end"}}) {
+    for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+      SCOPED_TRACE(k.expected);
+      sim::SimConfig sc = Tiny(0.5);
+      sc.imu.rate_hz = k.rate_hz;
+      sc.imu.clock_offset_s = k.clock_offset_s;
+      sim::SimulatedSource source(sc);
+      OdometryConfig c = Config();
+      c.method = m;
+      c.T_imu_lidar = source.ImuFromLidar();
+      LioOdometry odometry(c);
+      io::ScanFrame f;
+      ASSERT_TRUE(source.Next(&f));
+      for (const ImuSample& s : f.imu) odometry.AddImu(s);
+      LidarScan scan = lioapp::TakeLidarScan(&f);
+      const ScanResult r = odometry.AddScan(scan);
+      EXPECT_EQ(r.status, ScanStatus::kFailed);
+      EXPECT_THAT(r.message, HasSubstr(k.expected));
+      EXPECT_THAT(r.message, ::testing::Not(HasSubstr("units")));
+      EXPECT_THAT(r.message, ::testing::Not(HasSubstr("not still")));
+    }
+  }
 }
 
 }  // namespace

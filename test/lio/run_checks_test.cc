@@ -167,5 +167,32 @@ TEST(RunChecks, LidarGapsAndUnregisteredRunsByTheirDefinition) {
   EXPECT_EQ(lioapp::UnregisteredRunReason({scans[0]}), "");
 }
 
+// Issue 40: scan intervals that overlap (each scan's end 0.15 s late, past the next scan's start)
+// are named by the runner as such; the gravity initialisation they spoil (its window lands in
+// motion) no longer blames only the accelerometer's units.
+TEST(RunChecks, OverlappingScanIntervalsAreReportedAsTheCause) {
+  MutatedSource source(Short(), [](io::ScanFrame* f) {
+    f->end_ns += 150'000'000;
+    return true;
+  });
+  const lioapp::RunSummary run =
+      lioapp::RunOdometry(source, testing::SimLioConfig().ForMethod(LioMethod::kSingerLio));
+  ASSERT_GE(run.scans.size(), 25u);
+  EXPECT_EQ(run.overlapping_scans, int(run.scans.size()) - 1);
+  for (const char* part : {"scan 1: its interval [0.100000000, ", "] s begins 0.149",
+                           "s before the previous scan's end", "scan intervals overlap"}) {
+    EXPECT_NE(run.first_overlapping_scan.find(part), std::string::npos)
+        << run.first_overlapping_scan;
+  }
+  EXPECT_EQ(run.first_failure.find("accelerometer units or axes cannot be right"),
+            std::string::npos)
+      << run.first_failure;
+  // The clean sequence has none.
+  MutatedSource clean(Short(), [](io::ScanFrame*) { return true; });
+  EXPECT_EQ(lioapp::RunOdometry(clean, testing::SimLioConfig().ForMethod(LioMethod::kSingerLio))
+                .overlapping_scans,
+            0);
+}
+
 }  // namespace
 }  // namespace ctlio::lio

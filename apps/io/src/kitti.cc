@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/point_fields.h"
+#include "ctlio/io/point_time_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/io/warning_limiter.h"
@@ -123,9 +124,28 @@ bool KittiReader::Next(ScanFrame* frame) {
     frame->cloud.stamp_ns = stamp;
   }
   auto& c = frame->cloud;
-  if (point_times_[next_].empty()) {
+  bool from_azimuth = point_times_[next_].empty();
+  if (!from_azimuth) {
+    // The rules of every reader (point_time_check.h): times that cannot be a 0.1 s sweep are
+    // rescaled by a unit factor or replaced by azimuth times; points timed more than a period
+    // from the stamp are dropped (they used to stretch the scan over seconds).
+    const PointTimeCheck check = CheckPointTimes(&c, kPeriod);
+    if (check.verdict != PointTimeCheck::kSweep) {
+      from_azimuth = check.verdict == PointTimeCheck::kNotASweep;
+      if (warnings_->Count(from_azimuth ? "per-point times not a sweep"
+                                        : "per-point times rescaled")) {
+        LOG(WARNING) << point_times_[next_] << ": " << check.reason
+                     << (from_azimuth ? "; times recovered from the azimuth instead" : "");
+      }
+    }
+    if (!from_azimuth) {
+      DropPointsOutside(point_times_[next_], stamp - kPeriod - kPeriod / 10,
+                        stamp + kPeriod + kPeriod / 10, &c, warnings_.get());
+    }
+  }
+  if (from_azimuth) {
     static bool logged = false;
-    if (!logged) {
+    if (!logged && point_times_[next_].empty()) {
       LOG(INFO) << folder_ << ": no per-point times, filled from the azimuth (see kitti.h)";
       logged = true;
     }

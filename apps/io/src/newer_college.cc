@@ -11,6 +11,8 @@
 
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/ground_truth_check.h"
+#include "ctlio/io/point_fields.h"
+#include "ctlio/io/point_time_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/warning_limiter.h"
 
@@ -157,6 +159,17 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
     frame->cloud.stamp_ns = stamp;
   }
   PointCloud& c = frame->cloud;
+  // Times that cannot be a sweep (point_time_check.h, the rule of every reader): rescaled by a
+  // unit factor, or replaced by azimuth times (the Ouster stamps the scan start).
+  const PointTimeCheck check = CheckPointTimes(&c, std::max<int64_t>(nominal_period_ns_, 1));
+  if (check.verdict != PointTimeCheck::kSweep) {
+    const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
+    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+      LOG(WARNING) << path << ": " << check.reason
+                   << (azimuth ? "; times recovered from the azimuth instead" : "");
+    }
+    if (azimuth) FillTimesFromAzimuth(&c, StampAt::kScanStart, nominal_period_ns_);
+  }
   // Recovery: points whose time lies outside [stamp − tolerance, next stamp + tolerance] cannot be
   // placed on the trajectory between this scan and its neighbours; they are dropped, with a word.
   DropPointsOutside(path, stamp - tolerance, next_stamp + tolerance, &c, warnings_.get());

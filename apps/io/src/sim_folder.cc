@@ -16,6 +16,8 @@
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/ground_truth_check.h"
+#include "ctlio/io/point_fields.h"
+#include "ctlio/io/point_time_check.h"
 #include "ctlio/io/text_table.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/io/warning_limiter.h"
@@ -236,6 +238,18 @@ bool SimFolderReader::Next(ScanFrame* frame) {
     FailAt(folder_ + "/scans.csv", e.line,
            "lists " + std::to_string(e.points) + " points, " + e.file + " has " +
                std::to_string(frame->cloud.size() + frame->cloud.dropped_non_finite));
+  }
+  // Times that cannot be a sweep of the scan's length: the rule of every reader
+  // (point_time_check.h), rescaled by a unit factor or replaced by azimuth times.
+  const int64_t length = std::max<int64_t>(e.end_ns - e.start_ns, 1);
+  const PointTimeCheck check = CheckPointTimes(&frame->cloud, length);
+  if (check.verdict != PointTimeCheck::kSweep) {
+    const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
+    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+      LOG(WARNING) << e.file << ": " << check.reason
+                   << (azimuth ? "; times recovered from the azimuth instead" : "");
+    }
+    if (azimuth) FillTimesFromAzimuth(&frame->cloud, StampAt::kScanStart, length);
   }
   // Recovery as in the Newer College reader: points timed outside the scan's interval (± 10 % of
   // its length) are dropped with a warning naming the file.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <sstream>
 #include <vector>
 
 #include "ctlio/factors/imu/gravity_initialization.h"
@@ -26,6 +27,36 @@ bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig&
   const int64_t t0_ns =
       std::max(samples.front().t_ns,
                end_ns - static_cast<int64_t>(std::llround(config.gravity_init_duration * 1e9)));
+  // Too few samples in the window is a rate (or start) problem, not a units one: a 20 Hz IMU gives
+  // 4 samples in 0.2 s, whose mean the magnitude gate below would blame on the accelerometer's
+  // units or axes, and imu::InitializeGravity on the platform's motion. Named first, with the rate.
+  constexpr int kMinSamples = 10;  // imu::InitializeGravity's min_samples below
+  int in_window = 0;
+  for (const ImuSample& s : samples) in_window += s.t_ns >= t0_ns && s.t_ns <= end_ns;
+  if (in_window < kMinSamples) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "gravity initialisation: only " << in_window << " IMU samples in the "
+      << 1e-9 * double(end_ns - t0_ns) << " s before the first scan end (need " << kMinSamples
+      << "): ";
+    const double span_s = 1e-9 * double(samples.back().t_ns - samples.front().t_ns);
+    const double rate = samples.size() > 1 && span_s > 0 ? double(samples.size() - 1) / span_s : 0;
+    const double needed = kMinSamples / std::max(config.gravity_init_duration, 1e-9);
+    if (samples.size() < 2) {
+      m << "the IMU rate is too low (a single sample in the "
+        << 1e-9 * double(end_ns - samples.front().t_ns) << " s before the first scan end; needs "
+        << needed << " Hz for init.gravity_duration = " << config.gravity_init_duration << " s)";
+    } else if (rate < needed) {
+      m << "the IMU rate (about " << rate
+        << " Hz) is too low for init.gravity_duration = " << config.gravity_init_duration
+        << " s (needs " << needed << " Hz; a longer init.gravity_duration lowers that)";
+    } else {
+      m << "the IMU starts only " << 1e-9 * double(end_ns - samples.front().t_ns)
+        << " s before the first scan end (rate about " << rate << " Hz)";
+    }
+    *message = m.str();
+    return false;
+  }
   // Input gate (input_checks.h): an accelerometer in g, or columns swapped, shows as a mean
   // specific force far from the configured gravity. Named as such before the stillness tests of
   // imu::InitializeGravity, whose 0.3 m/s² limit would report it as mere motion or bias.
@@ -43,7 +74,7 @@ bool InitialiseGravity(const ImuBuffer& imu, double t_end, const OdometryConfig&
   imu::GravityInitializationOptions options;
   options.gravity = config.gravity;
   options.max_block_accel_deviation = config.gravity_init_max_std;
-  options.min_samples = 10;
+  options.min_samples = kMinSamples;
   try {
     *C_mi = imu::InitializeGravity(samples, t0_ns, end_ns - t0_ns + 1, options).C_mi;
     const Mat3 C_ri = config.ImuPose(config.input_imu).rotation();

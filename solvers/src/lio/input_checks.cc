@@ -63,7 +63,16 @@ std::optional<std::string> CheckGravityMagnitude(const std::vector<ImuSample>& s
   std::ostringstream m;
   m << "mean specific force " << g << " m/s² over the first " << samples.size()
     << " IMU samples is not the configured gravity " << gravity << " m/s² (±" << 100 * tolerance
-    << " %): accelerometer units or axes cannot be right";
+    << " %): ";
+  // A reading in g is about 1/9.81 of gravity: a units error. Any other magnitude is as likely a
+  // platform that accelerates in the window (not at rest, or a window misplaced by scan times
+  // that overlap) as wrong units or axes; both are named, the motion first.
+  if (std::abs(g * 9.80665 / gravity - 1.0) <= tolerance) {
+    m << "accelerometer units or axes cannot be right (it reads about 1: g, not m/s²?)";
+  } else {
+    m << "the platform accelerates in the window (not at rest at the start, or the scan times "
+         "put the window elsewhere), or the accelerometer units or axes are wrong";
+  }
   return m.str();
 }
 

@@ -20,6 +20,7 @@
 #include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/newer_college.h"
+#include "ctlio/io/point_time_check.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/ros_wire_check.h"
 #include "ctlio/io/warning_limiter.h"
@@ -164,7 +165,9 @@ struct RosbagSource::Impl {
   std::vector<ImuSample> imu;  // samples not yet handed out
   int64_t last_imu_ns = INT64_MIN, last_scan_start_ns = INT64_MIN;
   size_t duplicates = 0;
-  size_t unusable_scans = 0;  // handed on empty or with their nominal interval (AddScan)
+  size_t unusable_scans = 0;        // handed on empty or with their nominal interval (AddScan)
+  size_t retimed_scans = 0;         // per-point times rescaled or replaced (point_time_check.h)
+  size_t points_outside_sweep = 0;  // dropped: timed over a period from the stamp
   // Header stamps of the lidar messages: the last one and the last spacing (the scan period as
   // the bag shows it, for the nominal interval of an unusable scan).
   int64_t last_lidar_stamp_ns = INT64_MIN, last_lidar_spacing_ns = 0;
@@ -254,6 +257,19 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     } else if (s.preset) {
       s.extrinsic = s.preset->imu_from_lidar;
       s.extrinsic_origin = "the " + s.preset->name + " preset";
+      if (!edges.empty()) {
+        // The bag carries a tree, but not between these frames: the preset (recognised from the
+        // topic names unless --preset) is a guess that the bag is the preset's sensor (issue 40).
+        auto frame = [](const std::string& f) {
+          return f.empty() ? "(no frame_id)" : "'" + f + "'";
+        };
+        std::string why = " — a guess: the bag's /tf_static does not connect the IMU frame " +
+                          frame(s.imu_frame) + " and the lidar frame " + frame(s.lidar_frame);
+        if (options.preset.empty()) why = " (recognised from the topic names)" + why;
+        s.extrinsic_origin += why;
+        LOG(WARNING) << path << ": T_imu_lidar from " << s.extrinsic_origin
+                     << "; give `extrinsic:` in the config if the bag is another sensor's";
+      }
     } else if (!s.lidar_frame.empty() && s.lidar_frame == s.imu_frame) {
       s.extrinsic_origin = "identity (lidar and IMU share frame_id '" + s.lidar_frame + "')";
     }
@@ -295,6 +311,8 @@ const std::string& RosbagSource::lidar_topic() const { return impl_->lidar_topic
 const std::string& RosbagSource::imu_topic() const { return impl_->imu_topic; }
 uint64_t RosbagSource::bytes_read() const { return impl_->bytes; }
 size_t RosbagSource::unusable_scans() const { return impl_->unusable_scans; }
+size_t RosbagSource::retimed_scans() const { return impl_->retimed_scans; }
+size_t RosbagSource::points_outside_sweep() const { return impl_->points_outside_sweep; }
 
 SE3 RosbagSource::ImuFromLidar() const {
   if (impl_->extrinsic_origin.empty()) {
@@ -377,13 +395,56 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
   } else if (lidar_messages == 1) {
     LOG(INFO) << path << ": per-point time " << DescribeConvention(layout.convention);
   }
-  // A stamp at the scan start is the start (DataSource: start_ns = the scan stamp) even when the
-  // first returns were dropped; otherwise the earliest point is.
   const int64_t stamp = f.cloud.stamp_ns;
   if (last_lidar_stamp_ns != INT64_MIN && stamp > last_lidar_stamp_ns) {
     last_lidar_spacing_ns = stamp - last_lidar_stamp_ns;  // no overflow: both are ≥ 0 (ros::Time)
   }
   last_lidar_stamp_ns = stamp;
+  if (layout.time) {
+    // The same per-point time rules as the folder readers (point_time_check.h, dataset.h). Before
+    // the second stamp the period is unknown: twice the nominal one keeps a 5 Hz lidar's sweep.
+    const int64_t period = last_lidar_spacing_ns > 0
+                               ? last_lidar_spacing_ns
+                               : 2 * std::max<int64_t>(options.time.scan_period_ns, 1);
+    const PointTimeCheck check = CheckPointTimes(&f.cloud, period);
+    if (check.verdict != PointTimeCheck::kSweep) {
+      ++retimed_scans;
+      const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
+      if (warnings->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+        // An integer field of 8 or 16 bits cannot hold a sweep in ns (it wraps every 256 ns or
+        // 65.5 µs): the width is the likely cause, said with the field's type.
+        const size_t bytes = FieldDatatypeSize(layout.time->datatype);
+        const std::string narrow =
+            azimuth && bytes <= 2 && layout.time->datatype != kFloat32 &&
+                    layout.time->datatype != kFloat64
+                ? " (a " + FieldDatatypeName(layout.time->datatype) + " field holds at most " +
+                      std::to_string((1u << (8 * bytes - (layout.time->datatype == kInt8 ||
+                                                          layout.time->datatype == kInt16))) -
+                                     1) +
+                      " units: too narrow for a sweep)"
+                : "";
+        LOG(WARNING) << where << "time field " << DescribeConvention(layout.convention) << narrow
+                     << ": " << check.reason
+                     << (azimuth ? "; times recovered from the azimuth instead" : "");
+      }
+      if (azimuth) {
+        FillTimesFromAzimuth(
+            &f.cloud, layout.convention.stamp_at,
+            last_lidar_spacing_ns > 0 ? last_lidar_spacing_ns : options.time.scan_period_ns);
+      }
+    }
+    // A point timed more than a period (+10 %) from the stamp cannot belong to this sweep (either
+    // stamp position, scan start or end); it would stretch the scan over seconds. Dropped and
+    // counted, as in the folder readers.
+    const int64_t reach = period + period / 10;
+    int64_t lo = INT64_MIN, hi = INT64_MAX;
+    if (__builtin_sub_overflow(stamp, reach, &lo)) lo = INT64_MIN;
+    if (__builtin_add_overflow(stamp, reach, &hi)) hi = INT64_MAX;
+    points_outside_sweep +=
+        DropPointsOutside(where.substr(0, where.size() - 2), lo, hi, &f.cloud, warnings.get());
+  }
+  // A stamp at the scan start is the start (DataSource: start_ns = the scan stamp) even when the
+  // first returns were dropped; otherwise the earliest point is.
   f.start_ns = f.end_ns = stamp;
   if (f.cloud.has_times() && !f.cloud.points.empty()) {
     const auto [lo, hi] = std::minmax_element(f.cloud.times_ns.begin(), f.cloud.times_ns.end());
@@ -458,6 +519,15 @@ bool RosbagSource::Next(ScanFrame* frame) {
     s.warnings->LogTotals();
     if (s.duplicates > 0) {
       LOG(WARNING) << s.path << ": dropped " << s.duplicates << " duplicate IMU sample(s)";
+    }
+    if (s.retimed_scans > 0) {
+      LOG(WARNING) << s.path << ": " << s.lidar_topic << ": " << s.retimed_scans
+                   << " scan(s) whose per-point times were not a sweep (rescaled or recovered "
+                   << "from the azimuth)";
+    }
+    if (s.points_outside_sweep > 0) {
+      LOG(WARNING) << s.path << ": " << s.lidar_topic << ": dropped " << s.points_outside_sweep
+                   << " point(s) timed more than a scan period from their scan's stamp";
     }
     if (s.unusable_scans > 0) {
       LOG(WARNING) << s.path << ": " << s.lidar_topic << ": " << s.unusable_scans

@@ -75,6 +75,11 @@ class RosbagSource : public DataSource {
   // Scans read so far that had no usable points or no time spread (empty, all non-finite, all at
   // one instant): each is handed on with its nominal interval, warned about and counted here.
   size_t unusable_scans() const;
+  // Scans whose per-point times were not a sweep (point_time_check.h): rescaled by a unit factor
+  // or replaced by azimuth times, each with a warning.
+  size_t retimed_scans() const;
+  // Points dropped for a time more than a scan period (+10 %) from their scan's stamp.
+  size_t points_outside_sweep() const;
 
  private:
   struct Impl;
