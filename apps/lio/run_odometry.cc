@@ -18,6 +18,7 @@
 
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
+#include "ctlio/solvers/lio/calibrating_odometry.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "extrinsic_agreement.h"
 #include "run_checks.h"
@@ -299,7 +300,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   }
   if (const auto g = source.Gravity()) config.gravity = *g;
   // The odometry applies the input gates (config.input); the runner only reports them.
-  auto odometry = lio::MakeLioOdometry(config);
+  auto odometry = std::make_unique<lio::CalibratingOdometry>(config);
   odometry->SampleFinalTrajectory(options.trajectory_rate_hz);
   // T_mr first; T_imu_lidar at the end (below).
   const auto take_final = [&](const std::vector<std::pair<int64_t, SE3>>& samples) {

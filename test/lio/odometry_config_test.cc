@@ -235,7 +235,8 @@ TEST(OdometryConfig, CalibrationSection) {
   EXPECT_THROW(LoadOdometryConfig(
                    WriteTemp("cal_h.yaml", "calibration:\n  observability_horizon_scans: -1\n")),
                std::runtime_error);
-  // The warm-up replay (lio_odometry.h): off by default, and only for an estimated calibration.
+  // The warm-up replay (calibrating_odometry.h): off by default, and only for an estimated
+  // calibration.
   EXPECT_DOUBLE_EQ(o.calibration.warmup_replay_s, 0.0);
   EXPECT_FALSE(c.calibration.replays_warmup());
   const OdometryConfig w = LoadOdometryConfig(WriteTemp(

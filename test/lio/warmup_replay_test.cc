@@ -1,7 +1,7 @@
-// The calibration warm-up replay (calibration.warmup_replay_s, lio_odometry.h): the first seconds
-// are processed again from the estimates they produced, once, and the pipeline that replayed
-// them carries on. On tuning sequence medium/100 (16 beams, every 4th firing, both calibrations
-// from the wrong start: 20 ms clock offset, 3° / 10 cm extrinsic).
+// The calibration warm-up replay (calibration.warmup_replay_s, calibrating_odometry.h): the first
+// seconds are processed again from the estimates they produced, once, and the pipeline that
+// replayed them carries on. On tuning sequence medium/100 (16 beams, every 4th firing, both
+// calibrations from the wrong start: 20 ms clock offset, 3° / 10 cm extrinsic).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +11,7 @@
 
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
-#include "ctlio/solvers/lio/lio_odometry.h"
+#include "ctlio/solvers/lio/calibrating_odometry.h"
 #include "ctlio/solvers/lio/state_keys.h"
 #include "lio/run_odometry.h"
 
@@ -41,8 +41,8 @@ OdometryConfig TwoPassesLastHeld(const sim::SimulatedSource& source) {
 
 // Feeds every frame of `source` to `odometry`, each scan's status checked: the number of scans,
 // the index of the scan that replayed the warm-up (-1: none) and its result.
-void FeedAll(sim::SimulatedSource* source, LioOdometry* odometry, int* scans, int* replayed_at,
-             ScanResult* replay) {
+void FeedAll(sim::SimulatedSource* source, CalibratingOdometry* odometry, int* scans,
+             int* replayed_at, ScanResult* replay) {
   io::ScanFrame frame;
   *scans = 0;
   *replayed_at = -1;
@@ -62,7 +62,7 @@ TEST(WarmupReplay, ReplaysTheSpanOnceFromTheEstimatesItProduced) {
   sim::SimulatedSource source(WrongStart(1.5));
   OdometryConfig config = Calibrating(1.0);
   config.T_imu_lidar = source.ImuFromLidar();  // the perturbed nominal
-  LioOdometry odometry(config);
+  CalibratingOdometry odometry(config);
   io::ScanFrame frame;
   int scans = 0, replays = 0;
   int64_t first_begin = 0, previous_end = 0;
@@ -130,7 +130,7 @@ TEST(WarmupReplay, BoundedHistoryKeepsTheSpanUntilTheReplay) {
   OdometryConfig config = Calibrating(1.0);
   config.T_imu_lidar = source.ImuFromLidar();
   config.kept_results = 3;
-  LioOdometry odometry(config);
+  CalibratingOdometry odometry(config);
   io::ScanFrame frame;
   size_t scans = 0;
   bool replayed = false;
@@ -157,7 +157,7 @@ TEST(WarmupReplay, BoundedHistoryKeepsTheSpanUntilTheReplay) {
 // with the calibration held at those values; the scans after the span move it again.
 TEST(WarmupReplay, LaterPassStartsFromThePreviousOneAndTheLastHoldsTheSpan) {
   sim::SimulatedSource source(WrongStart(1.6));
-  LioOdometry odometry(TwoPassesLastHeld(source));
+  CalibratingOdometry odometry(TwoPassesLastHeld(source));
   int scans = 0, replayed_at = -1;
   ScanResult replay;
   ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));
@@ -204,7 +204,7 @@ TEST(WarmupReplay, FrozenLastPassIsTheEstimatorOfTheValuesItFroze) {
   OdometryConfig config = TwoPassesLastHeld(source);
   config.calibration.warmup_replay_hold = false;
   config.calibration.warmup_replay_freeze = true;
-  LioOdometry odometry(config);
+  CalibratingOdometry odometry(config);
   int scans = 0, replayed_at = -1;
   ScanResult replay;
   ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));
@@ -239,7 +239,7 @@ TEST(WarmupReplay, FrozenLastPassIsTheEstimatorOfTheValuesItFroze) {
   // The same data through a pipeline configured with the frozen values: the same poses.
   OdometryConfig known = frozen;
   known.kept_results = 0;
-  LioOdometry reference(known);
+  CalibratingOdometry reference(known);
   sim::SimulatedSource again(WrongStart(1.6));
   int reference_scans = 0, none = -1;
   ASSERT_NO_FATAL_FAILURE(FeedAll(&again, &reference, &reference_scans, &none, &replay));
@@ -259,7 +259,7 @@ TEST(WarmupReplay, UnobservableCoordinatesStartFromTheConfigAndAreNotHeld) {
   sim::SimulatedSource source(testing::WrongCalibrationSequence(sim::Regime::kSlow, 1.6, 0.020));
   const OdometryConfig config = TwoPassesLastHeld(source);
   const SE3 nominal = config.T_imu_lidar;
-  LioOdometry odometry(config);
+  CalibratingOdometry odometry(config);
   int scans = 0, replayed_at = -1;
   ScanResult replay;
   ASSERT_NO_FATAL_FAILURE(FeedAll(&source, &odometry, &scans, &replayed_at, &replay));

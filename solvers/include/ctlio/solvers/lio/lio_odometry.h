@@ -5,8 +5,14 @@
 //
 //   drop points timed outside the scan's interval → prepare scan → [first scan: initialise
 //   gravity and the first state] → marginalise the oldest state → add the new state with its
-//   motion/IMU factors → register the keypoints → check the estimate → update the map → check
-//   the IMU against the lidar's motion → report
+//   motion/IMU factors → [hold calibration coordinates] → register the keypoints → [release
+//   them] → check the estimate → update the map → check the IMU against the lidar's motion →
+//   report (with online calibration: observability and σ of the calibration states)
+//
+// The calibration states' hold, release and report are CalibrationStates' (calibration_states.h).
+// One pass over the data: the warm-up replay (calibration.warmup_replay_s) is
+// CalibratingOdometry's (calibrating_odometry.h), which runs this pipeline inside; constructed
+// here with a replay configured, it throws.
 //
 // Use: feed the IMU samples in time order with AddImu, and each scan with AddScan once the IMU
 // covers its end. Every scan returns a ScanResult whose status says whether the estimate is
@@ -18,12 +24,11 @@
 #include <deque>
 #include <future>
 #include <memory>
-#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "ctlio/solvers/lio/calibration_observability.h"
+#include "ctlio/solvers/lio/calibration_states.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/final_trajectory.h"
 #include "ctlio/solvers/lio/frontend.h"
@@ -52,29 +57,28 @@ class LioOdometry {
   // divergence, points outside the scan's interval, a frozen IMU) is reported in the result.
   ScanResult AddScan(const LidarScan& scan);
 
-  // After a warm-up replay (calibration.warmup_replay_s) everything below is the replayed
-  // pipeline's, which carries on: its config starts the calibration from the warm-up's estimates.
-  const OdometryConfig& config() const { return active().config_; }
+  const OdometryConfig& config() const { return config_; }
   // The newest config().kept_results results (all with 0), oldest first: a pipeline that runs
-  // for hours keeps a bounded history. While a warm-up replay is pending, every result of its
-  // span stays, and after it the replayed span's results are all here (the replay revised them).
-  const std::deque<ScanResult>& results() const { return active().results_; }
-  // The results returned live for the scans of the warm-up span, before the replay replaced
-  // them in results() (empty until a replay).
-  const std::deque<ScanResult>& warmup_results() const { return warmup_results_; }
-  size_t duplicate_imu_samples() const { return active().imu_.duplicates(); }
-  size_t rejected_imu_samples() const { return active().imu_.rejected(); }
-  bool initialised() const { return active().initialised_; }
+  // for hours keeps a bounded history.
+  const std::deque<ScanResult>& results() const { return results_; }
+  size_t duplicate_imu_samples() const { return imu_.duplicates(); }
+  size_t rejected_imu_samples() const { return imu_.rejected(); }
+  bool initialised() const { return initialised_; }
   // Gravity-aligned frame i → map frame m (valid once initialised()).
-  const Mat3& C_mi() const { return active().C_mi_; }
+  const Mat3& C_mi() const { return C_mi_; }
   // The window the pipeline solves (SPEC §5): its states, residual blocks and marginal prior.
-  const SlidingWindow& window() const { return active().window_; }
-  SlidingWindow& window() { return replay_ != nullptr ? replay_->window_ : window_; }
+  const SlidingWindow& window() const { return window_; }
+  SlidingWindow& window() { return window_; }
   // What the most recent Schur-complement marginalisation did (empty before the first one).
-  const MarginalizationReport& last_marginalization() const {
-    return active().last_marginalization_;
+  const MarginalizationReport& last_marginalization() const { return last_marginalization_; }
+  int num_marginalizations() const { return num_marginalizations_; }
+  // The calibration states' part (hold, observability, σ).
+  const CalibrationStates& calibration_states() const { return calibration_; }
+  // CalibrationStates::HoldUntil: holds the calibration coordinates of `mask` (empty: all) over
+  // every scan ending at most t_s seconds after the first scan began.
+  void HoldCalibrationUntil(double t_s, std::vector<bool> mask) {
+    calibration_.HoldUntil(t_s, std::move(mask));
   }
-  int num_marginalizations() const { return active().num_marginalizations_; }
   // The estimate T_mr sampled every 1/rate_hz s over the newest interval between states: the
   // grid times (multiples of the period in absolute ns) in (previous, newest state) and the newest
   // state's time, whose pose is the scan's T_mr. Empty before the second state.
@@ -84,45 +88,17 @@ class LioOdometry {
   // prepared, at the origin), the same vector the map was fed, not a copy. nullptr when the
   // newest scan inserted nothing (failed, implausible jump). Valid until the next AddScan.
   const std::vector<Vec3>* newest_map_points() const {
-    return active().map_points_inserted_ ? &active().map_points_ : nullptr;
+    return map_points_inserted_ ? &map_points_ : nullptr;
   }
   // The dense trajectory from the final estimates (final_trajectory.h): T_mr every 1/rate_hz s
-  // (0, the default: none; set before the first scan). A warm-up replay's pipeline carries it on
-  // from its own first scan (the replay revised the span's estimates). TakeFinalTrajectory: the
+  // (0, the default: none; set before the first scan). TakeFinalTrajectory: the
   // samples of the segments sealed since the previous call, time order; FinalTrajectoryTail: the
   // rest, from the state sealed last to the newest, once no scan follows.
   void SampleFinalTrajectory(double rate_hz) { final_trajectory_.set_rate(rate_hz); }
-  FinalTrajectory::Samples TakeFinalTrajectory();
+  FinalTrajectory::Samples TakeFinalTrajectory() { return final_trajectory_.Take(); }
   FinalTrajectory::Samples FinalTrajectoryTail() const;
 
  private:
-  const LioOdometry& active() const { return replay_ != nullptr ? *replay_ : *this; }
-  // AddScan's work on a checked scan.
-  ScanResult RunScan(const LidarScan& input);
-  // Warm-up replay: true while the data is kept for it.
-  bool KeepsWarmup() const { return config_.calibration.replays_warmup() && !warmup_done_; }
-  // After `result`'s scan: once the kept data spans warmup_replay_s and the scan was estimated,
-  // processes it again in replay_ from the estimates in `result` and replaces `result` with the
-  // replay's; gives up (note, data dropped) if twice the span passes without an estimate.
-  void MaybeReplayWarmup(ScanResult* result);
-  // The config of a replay pass started from `estimate` (calibration.warmup_replay_s).
-  OdometryConfig ReplayConfig(const ScanResult::CalibrationEstimate& estimate) const;
-  // What a frozen pass with `config` (ReplayConfig(estimate)) reports: its values, the
-  // estimate's σ, every coordinate marked held.
-  static ScanResult::CalibrationEstimate Frozen(const ScanResult::CalibrationEstimate& estimate,
-                                                const OdometryConfig& config);
-  void CheckScan(const LidarScan& scan) const;
-  // Input gate: the points timed outside [interval start − tolerance, end + tolerance]
-  // (config.input.scan_time_tolerance; the interval starts at the previous scan's end once
-  // initialised) are dropped into *trimmed, which is returned with *note saying so; `scan` itself
-  // when none is.
-  const LidarScan& DropPointsOutsideInterval(const LidarScan& scan, LidarScan* trimmed,
-                                             std::string* note) const;
-  // Robot-frame points (T_robot_lidar: the extrinsic or its estimate), range gate, voxel
-  // subsampling, keypoints, time order. Times within the tolerance outside the interval (driver
-  // clock jitter) are clamped onto it. Into prepared_ (its buffers' capacity is reused: fresh
-  // megabyte vectors per scan were page faults in every scan), which the reference returned is.
-  const PreparedScan& PrepareScan(const LidarScan& scan, const SE3& T_robot_lidar);
   // The extrinsic the next scan is prepared with: its online estimate, or the configured one.
   SE3 CurrentExtrinsic() const;
   // config.overlap_stages: the previous scan's map insertion and, before a registration, the
@@ -147,27 +123,6 @@ class LioOdometry {
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   void ReportPoseCovariance(ScanResult* result);
-  // With online calibration: the marginal σ of the calibration states (clock offsets, extrinsic)
-  // into result->calibration: the inverse of their marginal information in the whole window
-  // (MarginalInformation), the window's pseudo-inverse; NaN when that is not positive definite.
-  void ReportCalibrationCovariance(ScanResult* result);
-  // With online calibration and calibration.observability_horizon_scans > 0: the newest
-  // interval's information on the calibration coordinates into the horizon
-  // (calibration_observability.h), ν and the unobservable ones into result->calibration.
-  void AssessCalibrationObservability(ScanResult* result);
-  // Before the registration: a strong prior at the current value along every coordinate the
-  // previous scan left unobservable (calibration.hold_unobservable), or along those of
-  // hold_mask_ when the scan ends (t_end: seconds since the first scan began) within
-  // hold_calibration_until_s_, so that the solve does not move it; ReleaseCalibration removes
-  // them after the solve.
-  void HoldCalibration(double t_end, ScanResult* result);
-  void ReleaseCalibration();
-  // The calibration states the estimator keeps in the window (the baseline has none), in the
-  // order of the coordinates: the clock offsets (1-D each), then the extrinsic T_imu_lidar.
-  std::vector<StateId> CalibrationStates() const;
-  // Creates observability_ over the calibration states in the window; false when there are none
-  // or the check is off.
-  bool StartObservability();
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
@@ -199,10 +154,7 @@ class LioOdometry {
   bool initialised_ = false;
   std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
-  // Online calibration's observability (created at the first assessment) over the states of
-  // CalibrationStates(), and the hold priors of this scan.
-  std::unique_ptr<CalibrationObservability> observability_;
-  std::vector<ceres::ResidualBlockId> holds_;
+  CalibrationStates calibration_;
   int num_marginalizations_ = 0;
   PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused
   // Its points in the map frame (MapPoints) and the robot position they are inserted at: on the
@@ -213,21 +165,6 @@ class LioOdometry {
   // config.overlap_stages: whether this scan's marginalisation is done (overlapped with its
   // preprocessing).
   bool slid_ = false;
-  // Warm-up replay (calibration.warmup_replay_s): every IMU sample and scan of the span as given
-  // (each scan with the number of samples added before it), the pipeline that replayed them
-  // (every call is forwarded to it from then on), and the live results it replaced.
-  std::vector<ImuSample> warmup_imu_;
-  std::vector<std::pair<LidarScan, size_t>> warmup_scans_;
-  std::unique_ptr<LioOdometry> replay_;
-  std::deque<ScanResult> warmup_results_;
-  bool warmup_done_ = false;
-  // Set on the last pass of a held warm-up replay (calibration.warmup_replay_hold): the span,
-  // and which coordinates to hold (those observable when the pass started; empty: all).
-  double hold_calibration_until_s_ = -1.0;
-  std::vector<bool> hold_mask_;
-  // Set on the last pass of a frozen warm-up replay (calibration.warmup_replay_freeze): the
-  // values it runs with and their σ, reported with every result as held.
-  std::optional<ScanResult::CalibrationEstimate> frozen_calibration_;
   // The running map insertion (StartMapInsertion). Last: destroyed first, which waits for it
   // while the map and the points it reads still exist.
   std::future<double> map_insertion_;

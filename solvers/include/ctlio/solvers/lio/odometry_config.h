@@ -150,9 +150,10 @@ struct OdometryConfig {
   // default: it costs one more Jacobian evaluation and a factorisation per scan.
   bool pose_covariance = false;
 
-  // How many of the newest ScanResults LioOdometry::results() keeps (0: every one). Bounded so
-  // that the pipeline's memory does not grow with the length of the run (~1.1 kB a result and
-  // its notes); the odometry itself never reads them. Not a YAML key: a property of the caller.
+  // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
+  // every one). Bounded so that the pipeline's memory does not grow with the length of the run
+  // (~1.1 kB a result and its notes); the odometry itself never reads them. Not a YAML key: a
+  // property of the caller.
   size_t kept_results = 100;
 
   // --- Online lidar–IMU calibration (top-level YAML section `calibration`, calibration_options.h;
@@ -246,7 +247,7 @@ struct ScanResult {
   // does not grow when other processes share the cores.
   double cpu_ms = 0.0;
   // Earlier scans whose results this scan replaced (calibration.warmup_replay_s): that many
-  // entries before this one in LioOdometry::results() now hold the replayed estimates; a
+  // entries before this one in CalibratingOdometry::results() now hold the replayed estimates; a
   // caller that kept the earlier results re-reads them. 0 for every other scan.
   int revised_scans = 0;
   // Online calibration (OdometryConfig::calibration) after this scan: the estimates and their
