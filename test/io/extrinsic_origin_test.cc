@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "common/temp_dir.h"
+#include "common/warning_sink.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/rosbag_source.h"
@@ -22,25 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-class WarningSink : public google::LogSink {
- public:
-  WarningSink() { google::AddLogSink(this); }
-  ~WarningSink() override { google::RemoveLogSink(this); }
-  void send(google::LogSeverity severity, const char*, const char*, int, const struct ::tm*,
-            const char* message, size_t length) override {
-    if (severity != google::GLOG_WARNING) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    text_ += std::string(message, length) + "\n";
-  }
-  std::string text() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return text_;
-  }
-
- private:
-  std::mutex mutex_;
-  std::string text_;
-};
+using ::ctlio::testing::WarningSink;
 
 // Newer College 2020 topic names; /tf_static with one edge parent → child.
 void WriteBag(const std::string& path, const std::string& parent, const std::string& child) {

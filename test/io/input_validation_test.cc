@@ -28,6 +28,7 @@
 
 #include "common/expect_error.h"
 #include "common/temp_dir.h"
+#include "common/warning_sink.h"
 #include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/io/point_layout_check.h"
@@ -380,26 +381,7 @@ TEST(ExtrinsicCheck, CheckedExtrinsicRefusesWhatEigenWouldNormaliseSilently) {
 // ---------------------------------------------------------------------------------------------
 // Recovery of unusable bag scans
 
-// Collects the WARNING lines glog writes while it is installed.
-class WarningSink : public google::LogSink {
- public:
-  WarningSink() { google::AddLogSink(this); }
-  ~WarningSink() override { google::RemoveLogSink(this); }
-  void send(google::LogSeverity severity, const char*, const char*, int, const struct ::tm*,
-            const char* message, size_t length) override {
-    if (severity != google::GLOG_WARNING) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    lines_.emplace_back(message, length);
-  }
-  std::vector<std::string> lines() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return lines_;
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<std::string> lines_;
-};
+using ::ctlio::testing::WarningSink;
 
 TEST(BagRecovery, EmptyAllNonFiniteAndZeroDurationScansAreHandedOnAndCounted) {
   const fs::path d = testing::FreshTempDir("bag_recovery");

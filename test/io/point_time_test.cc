@@ -20,6 +20,7 @@
 #include <random>
 
 #include "common/temp_dir.h"
+#include "common/warning_sink.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_time_check.h"
@@ -71,28 +72,7 @@ double RawValue(Defect d, int i, std::mt19937* rng, double unit_per_ns) {
   return 0;
 }
 
-class WarningSink : public google::LogSink {
- public:
-  WarningSink() { google::AddLogSink(this); }
-  ~WarningSink() override { google::RemoveLogSink(this); }
-  void send(google::LogSeverity severity, const char*, const char*, int, const struct ::tm*,
-            const char* message, size_t length) override {
-    if (severity != google::GLOG_WARNING) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    lines_.emplace_back(message, length);
-  }
-  bool Has(const std::string& needle) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& l : lines_) {
-      if (l.find(needle) != std::string::npos) return true;
-    }
-    return false;
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<std::string> lines_;
-};
+using ::ctlio::testing::WarningSink;
 
 // Each scan's interval is a sweep again: about one period, and the points' times inside it.
 void ExpectSweeps(const std::vector<ScanFrame>& frames, size_t points) {

@@ -22,6 +22,7 @@
 
 #include "common/expect_error.h"
 #include "common/temp_dir.h"
+#include "common/warning_sink.h"
 #include "ctlio/io/dataset.h"
 #include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/kitti.h"
@@ -36,30 +37,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::ctlio::testing::ExpectError;
 
-class WarningSink : public google::LogSink {
- public:
-  WarningSink() { google::AddLogSink(this); }
-  ~WarningSink() override { google::RemoveLogSink(this); }
-  void send(google::LogSeverity severity, const char*, const char*, int, const struct ::tm*,
-            const char* message, size_t length) override {
-    if (severity != google::GLOG_WARNING) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    lines_.emplace_back(message, length);
-  }
-  std::vector<std::string> lines() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return lines_;
-  }
-  size_t CountContaining(const std::string& needle) {
-    size_t n = 0;
-    for (const std::string& l : lines()) n += l.find(needle) != std::string::npos;
-    return n;
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<std::string> lines_;
-};
+using ::ctlio::testing::WarningSink;
 
 // 10 points, times 0 … 9 µs after the stamp (x y z float32, t uint32).
 sensor_msgs::PointCloud2 Cloud(int64_t stamp_ns) {

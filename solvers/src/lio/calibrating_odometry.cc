@@ -6,27 +6,19 @@
 #include <sstream>
 #include <string>
 
+#include "scan_clock.h"
+
 namespace ctlio::lio {
+
+using internal::AddNote;
+using internal::MsSince;
+using internal::ThreadCpuMs;
 
 namespace {
 
 const OdometryConfig& Validated(const OdometryConfig& config) {
   config.Validate();
   return config;
-}
-
-double ThreadCpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-void AddNote(ScanResult* result, const std::string& note) {
-  result->message += (result->message.empty() ? "" : "; ") + note;
 }
 
 // `config` as one pass: no replay of its own.

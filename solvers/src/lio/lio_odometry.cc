@@ -15,8 +15,13 @@
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
 #include "ctlio/solvers/lio/state_keys.h"
+#include "scan_clock.h"
 
 namespace ctlio::lio {
+
+using internal::AddNote;
+using internal::MsSince;
+using internal::ThreadCpuMs;
 
 namespace {
 
@@ -43,21 +48,6 @@ SlidingWindowOptions WindowOptions(const OdometryConfig& config) {
   o.solver.minimizer_progress_to_stdout = false;
   o.solver.logging_type = ceres::SILENT;
   return o;
-}
-
-double ThreadCpuMs() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Appends a note to the scan's message ("; "-separated).
-void AddNote(ScanResult* result, const std::string& note) {
-  result->message += (result->message.empty() ? "" : "; ") + note;
 }
 
 std::vector<Vec3> Positions(const std::vector<TimedPoint>& points) {
