@@ -53,6 +53,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -103,6 +104,11 @@ DEFINE_double(max_imu_gap_error, 0.0,
               "Readers: an IMU gap longer than this [s] is an error naming file and line; 0 = off "
               "(the default: gaps are warnings, the odometry bridges them and flags the scans by "
               "init.max_imu_gap). Overrides input.max_imu_gap_error of --config");
+DEFINE_bool(strict, false,
+            "Every documented recovery of a reader or of the input gates (duplicate IMU samples "
+            "dropped, unusable scans handed on, points dropped, scans retimed or skipped, IMU "
+            "gaps, IMU samples rejected) is an error naming the defect; for pipelines that must "
+            "not guess (docs/user-guide/bad-input.md)");
 DEFINE_bool(progress, true, "Show progress on stderr");
 DEFINE_double(play_rate, 0.0,
               "Give each scan to the odometry at its own time on the wall clock, sped up by this "
@@ -384,6 +390,7 @@ int main(int argc, char** argv) {
         }
       }
       config.Validate();
+      ctlio::io::WarningLimiter::SetStrict(FLAGS_strict);  // before the readers read anything
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);

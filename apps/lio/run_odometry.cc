@@ -18,6 +18,7 @@
 
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/io/checked_output.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/solvers/lio/calibrating_odometry.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "extrinsic_agreement.h"
@@ -306,6 +307,15 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   const auto take_final = [&](const std::vector<std::pair<int64_t, SE3>>& samples) {
     for (const auto& [t, T_mr] : samples) run.dense.push_back({t, T_mr});
   };
+  // A recovery of the runner or of the odometry's input gates (a scan skipped, IMU samples
+  // rejected, points dropped) is an error in strict mode, as the readers' recoveries are.
+  auto recovered = [&](const std::string& m) {
+    if (io::WarningLimiter::Strict()) {
+      throw std::runtime_error(source.Name() + ": " + m +
+                               " (--strict / input.strict: a defect that would be recovered is an "
+                               "error; run without it to recover and log)");
+    }
+  };
   auto warn = [&](const std::string& m) {
     LOG(WARNING) << source.Name() << ": " << m;
     if (run.first_input_warning.empty()) run.first_input_warning = m;
@@ -332,6 +342,9 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
     if (have_previous && frame.end_ns <= previous_end) {
       ++run.scans_skipped;
+      recovered("scan " + std::to_string(frame.index) + " would be skipped: its end " +
+                io::FormatSecondsNs(frame.end_ns) + " s is not after the previous scan's " +
+                io::FormatSecondsNs(previous_end) + " s");
       warn("scan " + std::to_string(frame.index) + " skipped: its end " +
            io::FormatSecondsNs(frame.end_ns) + " s is not after the previous scan's " +
            io::FormatSecondsNs(previous_end) + " s");
@@ -358,6 +371,9 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     const lio::ScanResult r = odometry->AddScan(TakeLidarScan(&frame));
     run.imu_rejected += r.imu_rejected;
     run.points_dropped += r.points_dropped;
+    if (r.imu_rejected > 0 || r.points_dropped > 0) {
+      recovered("scan " + std::to_string(frame.index) + ": " + r.message);
+    }
     if (r.imu_rejected > 0 || r.points_dropped > 0 || r.status == lio::ScanStatus::kSuspect) {
       warn("scan " + std::to_string(frame.index) + ": " + r.message);
     }

@@ -219,5 +219,50 @@ TEST(WarningLimiter, CountsPerKindAndReportsTotalsOnce) {
   EXPECT_EQ(sink.CountContaining(" b warnings"), 0u);  // all of them were shown
 }
 
+// Strict input (ctlio_odometry --strict): the first recovery of any kind is an error naming the
+// source and the defect, in every reader (they all count their recoveries with a WarningLimiter).
+class StrictInput {
+ public:
+  StrictInput() { WarningLimiter::SetStrict(true); }
+  ~StrictInput() { WarningLimiter::SetStrict(false); }
+};
+
+TEST(WarningLimiter, StrictThrowsOnTheFirstWarningNamingSourceAndKind) {
+  {
+    StrictInput strict;
+    WarningLimiter limiter("f.csv");
+    testing::ExpectError([&] { limiter.Count("duplicate IMU time"); },
+                         {"f.csv: duplicate IMU time", "--strict"});
+  }
+  WarningLimiter lenient("f.csv");  // and off again: counted, not thrown
+  EXPECT_TRUE(lenient.Count("duplicate IMU time"));
+}
+
+TEST(WarningLimiter, StrictMakesADuplicateImuStampAnError) {
+  std::vector<ImuSample> imu(3);
+  imu[0].t_ns = 1'000'000;
+  imu[1].t_ns = imu[2].t_ns = 6'000'000;
+  std::vector<ImuSample> copy = imu;
+  CheckImuStream("imu.csv", {2, 3, 4}, 0, &copy);
+  EXPECT_EQ(copy.size(), 2u);  // recovered without strict
+  StrictInput strict;
+  testing::ExpectError(
+      [&] {
+        CheckImuStream("imu.csv", {2, 3, 4}, 0, &imu);
+      },
+      {"imu.csv:4: duplicate IMU time", "--strict"});
+}
+
+TEST(WarningLimiter, StrictMakesAnUnusableKittiScanAnError) {
+  const fs::path k = testing::FreshTempDir("strict_kitti");
+  fs::create_directories(k / "velodyne");
+  std::ofstream(k / "velodyne" / "000000.bin", std::ios::binary).flush();
+  std::ofstream(k / "times.txt") << "0.0\n";
+  StrictInput strict;
+  KittiReader reader(k.string());
+  ScanFrame f;
+  testing::ExpectError([&] { reader.Next(&f); }, {"000000.bin", "--strict"});
+}
+
 }  // namespace
 }  // namespace ctlio::io

@@ -67,7 +67,11 @@ size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, 
     ++kept;
   }
   if (kept == n) return 0;
-  if (warnings == nullptr || warnings->Count("points outside the scan interval")) {
+  if (warnings == nullptr ||
+      warnings->Count("points outside the scan interval",
+                      path + ": " + std::to_string(n - kept) + " of " + std::to_string(n) +
+                          " points outside [" + FormatSecondsNs(lo_ns) + ", " +
+                          FormatSecondsNs(hi_ns) + "] s")) {
     LOG(WARNING) << path << ": dropped " << n - kept << " of " << n
                  << " points whose time lies outside the scan interval [" << FormatSecondsNs(lo_ns)
                  << ", " << FormatSecondsNs(hi_ns) << "] s";
@@ -92,7 +96,7 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
       const int64_t prev = kept.back().t_ns;
       if (s.t_ns == prev) {
         ++duplicates;
-        if (limiter.Count("duplicate IMU time")) {
+        if (limiter.Count("duplicate IMU time", path + ":" + std::to_string(line))) {
           LOG(WARNING) << path << ":" << line << ": duplicate IMU time " << s.t_ns
                        << " ns, sample dropped";
         }
@@ -125,7 +129,8 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   const int64_t median = sorted[sorted.size() / 2];
   for (size_t i = 0; i < dt.size(); ++i) {
     if (dt[i] <= 3 * median) continue;
-    if (limiter.Count("IMU gap")) {
+    if (limiter.Count("IMU gap",
+                      path + ":" + std::to_string(i + 1 < lines.size() ? lines[i + 1] : 0))) {
       LOG(WARNING) << path << ":" << (i + 1 < lines.size() ? lines[i + 1] : 0) << ": gap of "
                    << 1e-9 * double(dt[i]) << " s in the IMU (median spacing "
                    << 1e-9 * double(median) << " s); samples handed on";

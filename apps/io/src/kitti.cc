@@ -117,7 +117,7 @@ bool KittiReader::Next(ScanFrame* frame) {
   try {
     frame->cloud = ReadKittiBin(path, floats_per_point_, point_times_[next_], stamp);
   } catch (const UnusableCloudError& e) {
-    if (warnings_->Count("unusable scan")) {
+    if (warnings_->Count("unusable scan", e.what())) {
       LOG(WARNING) << e.what() << "; handed on as an empty scan";
     }
     frame->cloud = PointCloud();
@@ -132,8 +132,9 @@ bool KittiReader::Next(ScanFrame* frame) {
     const PointTimeCheck check = CheckPointTimes(&c, kPeriod);
     if (check.verdict != PointTimeCheck::kSweep) {
       from_azimuth = check.verdict == PointTimeCheck::kNotASweep;
-      if (warnings_->Count(from_azimuth ? "per-point times not a sweep"
-                                        : "per-point times rescaled")) {
+      if (warnings_->Count(
+              from_azimuth ? "per-point times not a sweep" : "per-point times rescaled",
+              point_times_[next_] + ": " + check.reason)) {
         LOG(WARNING) << point_times_[next_] << ": " << check.reason
                      << (from_azimuth ? "; times recovered from the azimuth instead" : "");
       }
@@ -165,7 +166,7 @@ bool KittiReader::Next(ScanFrame* frame) {
   if (frame->end_ns <= frame->start_ns) {
     // Recovery shared with the other layouts: without usable points (empty, all non-finite) or
     // with all points at one time the scan gets its nominal interval, up to the next stamp.
-    if (warnings_->Count("scan without an interval")) {
+    if (warnings_->Count("scan without an interval", path)) {
       LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
                    << " non-finite), all at one time; scan interval set to its nominal 0.1 s";
     }

@@ -152,7 +152,7 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
   try {
     frame->cloud = ReadPcd(path, ro);
   } catch (const UnusableCloudError& e) {
-    if (warnings_->Count("unusable scan")) {
+    if (warnings_->Count("unusable scan", e.what())) {
       LOG(WARNING) << e.what() << "; handed on as an empty scan";
     }
     frame->cloud = PointCloud();
@@ -164,7 +164,8 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
   const PointTimeCheck check = CheckPointTimes(&c, std::max<int64_t>(nominal_period_ns_, 1));
   if (check.verdict != PointTimeCheck::kSweep) {
     const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
-    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled",
+                         path + ": " + check.reason)) {
       LOG(WARNING) << path << ": " << check.reason
                    << (azimuth ? "; times recovered from the azimuth instead" : "");
     }
@@ -181,7 +182,7 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
     // (empty, all non-finite) or with all points at the stamp the file gives no interval; the
     // scan gets its nominal one, up to the next stamp. An empty scan is reported degenerate by the
     // odometry.
-    if (warnings_->Count("scan without an interval")) {
+    if (warnings_->Count("scan without an interval", path)) {
       LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
                    << " non-finite), none after the stamp; scan interval set to ["
                    << FormatSecondsNs(stamp) << ", " << FormatSecondsNs(next_stamp) << ") s";

@@ -245,7 +245,8 @@ bool SimFolderReader::Next(ScanFrame* frame) {
   const PointTimeCheck check = CheckPointTimes(&frame->cloud, length);
   if (check.verdict != PointTimeCheck::kSweep) {
     const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
-    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+    if (warnings_->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled",
+                         e.file + ": " + check.reason)) {
       LOG(WARNING) << e.file << ": " << check.reason
                    << (azimuth ? "; times recovered from the azimuth instead" : "");
     }

@@ -352,7 +352,8 @@ void RosbagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
                                " s in the IMU (limit " +
                                std::to_string(1e-9 * double(options.max_imu_gap_ns)) + " s)");
     }
-    if (warnings->Count("IMU gap")) {
+    if (warnings->Count("IMU gap",
+                        Where(imu_topic, imu_messages) + "gap of " + std::to_string(gap) + " s")) {
       LOG(WARNING) << Where(imu_topic, imu_messages) << "gap of " << gap
                    << " s in the IMU; samples handed on";
     }
@@ -410,7 +411,8 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
     if (check.verdict != PointTimeCheck::kSweep) {
       ++retimed_scans;
       const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
-      if (warnings->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled")) {
+      if (warnings->Count(azimuth ? "per-point times not a sweep" : "per-point times rescaled",
+                          where + check.reason)) {
         // An integer field of 8 or 16 bits cannot hold a sweep in ns (it wraps every 256 ns or
         // 65.5 µs): the width is the likely cause, said with the field's type.
         const size_t bytes = FieldDatatypeSize(layout.time->datatype);
@@ -468,7 +470,8 @@ void RosbagSource::Impl::AddScan(const sensor_msgs::PointCloud2& m) {
                                " ns leaves no room for a scan period");
     }
     ++unusable_scans;
-    if (warnings->Count("unusable scan")) {
+    if (warnings->Count("unusable scan",
+                        where + std::to_string(f.cloud.size()) + " usable points")) {
       LOG(WARNING) << where << f.cloud.size() << " usable points (" << f.cloud.dropped_non_finite
                    << " non-finite), " << (f.cloud.points.empty() ? "none" : "all at one instant")
                    << ": handed on with its nominal interval [" << FormatSecondsNs(lo) << ", "

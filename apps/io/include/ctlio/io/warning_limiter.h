@@ -7,8 +7,10 @@
 
 #include <glog/logging.h>
 
+#include <atomic>
 #include <cstddef>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -22,8 +24,24 @@ class WarningLimiter {
   explicit WarningLimiter(std::string source, size_t shown = kDefaultShown)
       : source_(std::move(source)), shown_(shown) {}
 
+  // Strict input (ctlio_odometry --strict, config `input.strict`): every recovery a reader
+  // applies is a defect the user asked not to have guessed around, so the first warning of any
+  // kind throws instead, naming the source and the defect. Process-wide, because a reader's
+  // limiters are created inside its constructor and its calls (CheckImuStream makes its own).
+  static void SetStrict(bool strict) { StrictFlag().store(strict); }
+  static bool Strict() { return StrictFlag().load(); }
+
   // Counts one warning of `kind`; true when it is among the first `shown` of its kind (log it).
-  bool Count(const std::string& kind) { return ++counts_[kind] <= shown_; }
+  // In strict mode it throws instead: `<detail>: <kind> (--strict: …)`, the detail being where the
+  // defect is (file and line, bag message, the reader's own message), by default the source.
+  bool Count(const std::string& kind, const std::string& detail = {}) {
+    if (Strict()) {
+      throw std::runtime_error((detail.empty() ? source_ : detail) + ": " + kind +
+                               " (--strict / input.strict: a defect that would be recovered "
+                               "is an error; run without it to recover and log)");
+    }
+    return ++counts_[kind] <= shown_;
+  }
 
   size_t count(const std::string& kind) const {
     const auto it = counts_.find(kind);
@@ -43,6 +61,11 @@ class WarningLimiter {
   }
 
  private:
+  static std::atomic<bool>& StrictFlag() {
+    static std::atomic<bool> strict{false};
+    return strict;
+  }
+
   std::string source_;
   size_t shown_;
   std::map<std::string, size_t> counts_, reported_;
