@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "ctlio/eval/trajectory_metrics.h"
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/warning_limiter.h"
 #include "ctlio/solvers/lio/calibrating_odometry.h"
@@ -351,11 +352,13 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       continue;
     }
     if (have_previous && frame.start_ns < previous_end &&
-        previous_end - frame.start_ns > (frame.end_ns - frame.start_ns) / 10) {
+        SaturatingSubNs(previous_end, frame.start_ns) >
+            SaturatingSubNs(frame.end_ns, frame.start_ns) / 10) {
       const std::string m =
           "scan " + std::to_string(frame.index) + ": its interval [" +
           io::FormatSecondsNs(frame.start_ns) + ", " + io::FormatSecondsNs(frame.end_ns) +
-          "] s begins " + std::to_string(1e-9 * double(previous_end - frame.start_ns)) +
+          "] s begins " +
+          std::to_string(1e-9 * double(SaturatingSubNs(previous_end, frame.start_ns))) +
           " s before the previous scan's end " + io::FormatSecondsNs(previous_end) +
           " s: scan intervals overlap (wrong scan start/end times?)";
       if (run.overlapping_scans++ < 5) warn(m);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
@@ -107,10 +108,11 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
                "IMU time goes backwards (" + std::to_string(s.t_ns) + " ns after " +
                    std::to_string(prev) + " ns)");
       }
-      if (max_gap_error_ns > 0 && s.t_ns - prev > max_gap_error_ns) {
+      if (max_gap_error_ns > 0 && SaturatingSubNs(s.t_ns, prev) > max_gap_error_ns) {
         FailAt(path, line,
-               "gap of " + std::to_string(1e-9 * double(s.t_ns - prev)) + " s in the IMU (limit " +
-                   std::to_string(1e-9 * double(max_gap_error_ns)) + " s, --max_imu_gap_error)");
+               "gap of " + std::to_string(1e-9 * double(SaturatingSubNs(s.t_ns, prev))) +
+                   " s in the IMU (limit " + std::to_string(1e-9 * double(max_gap_error_ns)) +
+                   " s, --max_imu_gap_error)");
       }
     }
     kept.push_back(s);
@@ -122,13 +124,14 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
   // Gaps are reported, not fatal by default: the odometry bridges them with its motion prior.
   // A gap is a spacing above 3× the median spacing.
   std::vector<int64_t> dt;
-  for (size_t i = 1; i < imu->size(); ++i) dt.push_back((*imu)[i].t_ns - (*imu)[i - 1].t_ns);
+  for (size_t i = 1; i < imu->size(); ++i)
+    dt.push_back(SaturatingSubNs((*imu)[i].t_ns, (*imu)[i - 1].t_ns));
   if (dt.size() < 2) return;
   std::vector<int64_t> sorted = dt;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const int64_t median = sorted[sorted.size() / 2];
   for (size_t i = 0; i < dt.size(); ++i) {
-    if (dt[i] <= 3 * median) continue;
+    if (dt[i] <= SaturatingAddNs(SaturatingAddNs(median, median), median)) continue;
     if (limiter.Count("IMU gap",
                       path + ":" + std::to_string(i + 1 < lines.size() ? lines[i + 1] : 0))) {
       LOG(WARNING) << path << ":" << (i + 1 < lines.size() ? lines[i + 1] : 0) << ": gap of "

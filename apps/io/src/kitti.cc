@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/point_fields.h"
 #include "ctlio/io/point_time_check.h"
 #include "ctlio/io/text_table.h"
@@ -140,8 +141,8 @@ bool KittiReader::Next(ScanFrame* frame) {
       }
     }
     if (!from_azimuth) {
-      DropPointsOutside(point_times_[next_], stamp - kPeriod - kPeriod / 10,
-                        stamp + kPeriod + kPeriod / 10, &c, warnings_.get());
+      DropPointsOutside(point_times_[next_], SaturatingSubNs(stamp, kPeriod + kPeriod / 10),
+                        SaturatingAddNs(stamp, kPeriod + kPeriod / 10), &c, warnings_.get());
     }
   }
   if (from_azimuth) {
@@ -153,8 +154,11 @@ bool KittiReader::Next(ScanFrame* frame) {
     // KITTI stamps a sweep when the scanner faces forward (azimuth 0): the sweep begins half a
     // revolution earlier, facing backwards.
     c.times_ns.resize(c.size());
+    // The sweep [stamp − P/2, stamp + P/2) must be representable (a stamp near the int64 limits).
+    const int64_t sweep_begin = CheckedAddNs(stamp, -kPeriod / 2, path);
+    CheckedAddNs(sweep_begin, kPeriod, path);
     for (size_t i = 0; i < c.size(); ++i) {
-      c.times_ns[i] = stamp - kPeriod / 2 + AzimuthOffsetNs(c.points[i], M_PI, kPeriod);
+      c.times_ns[i] = sweep_begin + AzimuthOffsetNs(c.points[i], M_PI, kPeriod);
     }
   }
   frame->start_ns = c.times_ns.empty()
@@ -170,8 +174,9 @@ bool KittiReader::Next(ScanFrame* frame) {
       LOG(WARNING) << path << ": " << c.size() << " usable points (" << c.dropped_non_finite
                    << " non-finite), all at one time; scan interval set to its nominal 0.1 s";
     }
-    const int64_t next_stamp = next_ + 1 < times_.size() ? times_[next_ + 1] : stamp + kPeriod;
-    frame->end_ns = std::max(frame->start_ns + 1, std::min(stamp + kPeriod, next_stamp - 1));
+    const int64_t nominal_end = CheckedAddNs(stamp, kPeriod, path);
+    const int64_t next_stamp = next_ + 1 < times_.size() ? times_[next_ + 1] : nominal_end;
+    frame->end_ns = std::max(frame->start_ns + 1, std::min(nominal_end, next_stamp - 1));
   }
   frame->imu.clear();
   ++next_;

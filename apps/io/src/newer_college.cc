@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/ground_truth_check.h"
 #include "ctlio/io/point_fields.h"
@@ -142,8 +143,9 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
   const auto& [stamp, path] = scans_[next_];
   // The scan's interval: from its stamp to the next scan's stamp (the last scan: one nominal
   // period, the median stamp spacing), with a tolerance for driver jitter.
-  const int64_t next_stamp =
-      next_ + 1 < scans_.size() ? scans_[next_ + 1].first : stamp + nominal_period_ns_;
+  const int64_t next_stamp = next_ + 1 < scans_.size()
+                                 ? scans_[next_ + 1].first
+                                 : CheckedAddNs(stamp, nominal_period_ns_, path);
   const int64_t tolerance = std::max<int64_t>(nominal_period_ns_ / 10, 1);
   ReadOptions ro;
   ro.stamp_ns = stamp;
@@ -173,7 +175,8 @@ bool NewerCollegeReader::Next(ScanFrame* frame) {
   }
   // Recovery: points whose time lies outside [stamp − tolerance, next stamp + tolerance] cannot be
   // placed on the trajectory between this scan and its neighbours; they are dropped, with a word.
-  DropPointsOutside(path, stamp - tolerance, next_stamp + tolerance, &c, warnings_.get());
+  DropPointsOutside(path, SaturatingSubNs(stamp, tolerance), SaturatingAddNs(next_stamp, tolerance),
+                    &c, warnings_.get());
   frame->start_ns = stamp;
   frame->end_ns = stamp;
   for (int64_t t : c.times_ns) frame->end_ns = std::max(frame->end_ns, t);

@@ -13,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/ground_truth_check.h"
@@ -50,7 +51,7 @@ PointCloud ReadSimScan(const std::string& path, int64_t start_ns) {
       continue;
     }
     c.points.push_back(x);
-    c.times_ns.push_back(start_ns + int64_t(dt));
+    c.times_ns.push_back(CheckedAddNs(start_ns, int64_t(dt), path));
   }
   return c;
 }
@@ -241,7 +242,7 @@ bool SimFolderReader::Next(ScanFrame* frame) {
   }
   // Times that cannot be a sweep of the scan's length: the rule of every reader
   // (point_time_check.h), rescaled by a unit factor or replaced by azimuth times.
-  const int64_t length = std::max<int64_t>(e.end_ns - e.start_ns, 1);
+  const int64_t length = std::max<int64_t>(SaturatingSubNs(e.end_ns, e.start_ns), 1);
   const PointTimeCheck check = CheckPointTimes(&frame->cloud, length);
   if (check.verdict != PointTimeCheck::kSweep) {
     const bool azimuth = check.verdict == PointTimeCheck::kNotASweep;
@@ -254,9 +255,9 @@ bool SimFolderReader::Next(ScanFrame* frame) {
   }
   // Recovery as in the Newer College reader: points timed outside the scan's interval (± 10 % of
   // its length) are dropped with a warning naming the file.
-  const int64_t tolerance = std::max<int64_t>((e.end_ns - e.start_ns) / 10, 1);
-  DropPointsOutside(e.file, e.start_ns - tolerance, e.end_ns + tolerance, &frame->cloud,
-                    warnings_.get());
+  const int64_t tolerance = std::max<int64_t>(length / 10, 1);
+  DropPointsOutside(e.file, SaturatingSubNs(e.start_ns, tolerance),
+                    SaturatingAddNs(e.end_ns, tolerance), &frame->cloud, warnings_.get());
   frame->start_ns = e.start_ns;
   frame->end_ns = e.end_ns;
   frame->imu.clear();

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/solvers/lio/input_checks.h"
 
 namespace ctlio::lio {
@@ -47,7 +48,9 @@ const LidarScan& DropPointsOutsideInterval(const LidarScan& scan, int64_t interv
                                            std::string* note) {
   const int64_t tolerance = std::llround(tolerance_s * 1e9);
   const int64_t begin = interval_begin_ns;
-  const int64_t lo = begin - tolerance, hi = scan.end_ns + tolerance;
+  // Saturating: a window wrapped around the int64 limits was inverted and dropped the whole scan.
+  const int64_t lo = SaturatingSubNs(begin, tolerance),
+                hi = SaturatingAddNs(scan.end_ns, tolerance);
   const auto outside = [&](int64_t t) { return t < lo || t > hi; };
   if (std::none_of(scan.times_ns.begin(), scan.times_ns.end(), outside)) return scan;
   *trimmed = scan;
