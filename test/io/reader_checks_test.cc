@@ -264,5 +264,22 @@ TEST(WarningLimiter, StrictMakesAnUnusableKittiScanAnError) {
   testing::ExpectError([&] { reader.Next(&f); }, {"000000.bin", "--strict"});
 }
 
+TEST(WarningLimiter, StrictMakesAnImuGapInABagAnErrorNamingTheMessage) {
+  const fs::path d = testing::FreshTempDir("strict_bag");
+  std::vector<int64_t> imu;  // a 0.2 s gap in a 10 ms IMU after the third sample
+  for (int64_t t : {10, 20, 30, 230, 240}) imu.push_back(t * 1'000'000);
+  const std::string bag = (d / "gap.bag").string();
+  WriteBag(bag, imu, {});
+  StrictInput strict;
+  testing::ExpectError(
+      [&] {
+        RosbagSource s(bag);
+        ScanFrame f;
+        while (s.Next(&f)) {
+        }
+      },
+      {"gap.bag", "message 4", "IMU gap", "--strict"});
+}
+
 }  // namespace
 }  // namespace ctlio::io
