@@ -18,6 +18,7 @@
 #include "common/warning_sink.h"
 #include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/kitti.h"
+#include "ctlio/io/newer_college.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
 
 namespace ctlio::io {
@@ -113,6 +114,46 @@ TEST(TimeOverflow, TheOdometryToleranceWindowNearTheLimitsDropsNoPointOfTheScan)
     EXPECT_EQ(kept.points.size(), 101u) << end;
     EXPECT_TRUE(note.empty()) << note;
   }
+}
+
+// Newer College (PCD scans named by their stamp, per-point `t` in ns since it): the reader's window
+// for the last scan, [stamp − 10 ms, stamp + period + 10 ms], passes INT64_MAX; its points stay.
+TEST(TimeOverflow, NewerCollegeScansNearInt64MaxKeepTheirPoints) {
+  const fs::path dir = testing::FreshTempDir("overflow_nc");
+  const fs::path scans = dir / "raw_format" / "ouster_zip_files" / "ouster_scan";
+  fs::create_directories(scans);
+  fs::create_directories(dir / "raw_format" / "ouster_imu");
+  constexpr int64_t kSec = 9'223'372'036, kPeriod = 100'000'000;
+  std::ofstream imu(dir / "raw_format" / "ouster_imu" / "data.csv");
+  imu << "counter,sec,nsec,wx,wy,wz,ax,ay,az\n";
+  for (int64_t ns = 500'000'000, k = 0; ns <= 850'000'000; ns += 5'000'000, ++k) {
+    imu << k << ',' << kSec << ',' << ns << ",0,0,0,0,0,9.81\n";
+  }
+  imu.close();
+  constexpr int kPoints = 360;
+  for (int k = 0; k < 3; ++k) {
+    const int64_t ns = 550'000'000 + k * kPeriod;  // the last stamp: 0.105 s before INT64_MAX
+    std::ofstream out(scans /
+                      ("cloud_" + std::to_string(kSec) + "_" + std::to_string(ns) + ".pcd"));
+    out << "FIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH " << kPoints
+        << "\nHEIGHT 1\nPOINTS " << kPoints << "\nDATA ascii\n";
+    for (int i = 0; i < kPoints; ++i) {
+      const double a = -2 * M_PI * i / kPoints;
+      out << float(10 * std::cos(a)) << ' ' << float(10 * std::sin(a)) << ' '
+          << float(0.1 * (i % 16)) << ' ' << int64_t(i) * kPeriod / kPoints << '\n';
+    }
+  }
+  testing::WarningSink sink;
+  NewerCollegeReader r(dir.string());
+  ScanFrame f;
+  int frames = 0;
+  while (r.Next(&f)) {
+    ++frames;
+    EXPECT_EQ(f.cloud.size(), size_t(kPoints)) << "scan " << f.index;
+    EXPECT_LT(f.start_ns, f.end_ns) << "scan " << f.index;
+  }
+  EXPECT_EQ(frames, 3);
+  EXPECT_FALSE(sink.Has("dropped"));
 }
 
 }  // namespace
