@@ -313,7 +313,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   auto recovered = [&](const std::string& m) {
     if (io::WarningLimiter::Strict()) {
       throw std::runtime_error(source.Name() + ": " + m +
-                               " (--strict / input.strict: a defect that would be recovered is an "
+                               " (--strict: a defect that would be recovered is an "
                                "error; run without it to recover and log)");
     }
   };

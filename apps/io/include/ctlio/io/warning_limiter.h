@@ -24,7 +24,7 @@ class WarningLimiter {
   explicit WarningLimiter(std::string source, size_t shown = kDefaultShown)
       : source_(std::move(source)), shown_(shown) {}
 
-  // Strict input (ctlio_odometry --strict, config `input.strict`): every recovery a reader
+  // Strict input (ctlio_odometry --strict; library users: SetStrict): every recovery a reader
   // applies is a defect the user asked not to have guessed around, so the first warning of any
   // kind throws instead, naming the source and the defect. Process-wide, because a reader's
   // limiters are created inside its constructor and its calls (CheckImuStream makes its own).
@@ -37,7 +37,7 @@ class WarningLimiter {
   bool Count(const std::string& kind, const std::string& detail = {}) {
     if (Strict()) {
       throw std::runtime_error((detail.empty() ? source_ : detail) + ": " + kind +
-                               " (--strict / input.strict: a defect that would be recovered "
+                               " (--strict: a defect that would be recovered "
                                "is an error; run without it to recover and log)");
     }
     return ++counts_[kind] <= shown_;
