@@ -66,7 +66,9 @@
 #include "lio/map_output.h"
 #include "lio/output_files.h"
 #include "lio/progress.h"
+#include "lio/run_evaluation.h"
 #include "lio/run_odometry.h"
+#include "lio/run_outputs.h"
 
 DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
 DEFINE_string(
@@ -177,6 +179,8 @@ DEFINE_string(sim_imu_dropout, "",
 
 namespace {
 
+using ::ctlio::apps::SplitList;
+
 using namespace ctlio;
 
 // A --sim_* flag applies unless a preset is chosen and the flag was not given explicitly.
@@ -277,51 +281,6 @@ bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& 
   return ok;
 }
 
-std::vector<std::string> Split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
-// With the extrinsic estimated or a perturbed nominal one: the starting and final extrinsic
-// errors against the truth (rotation angle [deg], translation [cm]; sim/extrinsic_error.h), the
-// final marginal σ per axis [ρ: cm; φ: deg] and whether the final error δ = Log(T_true·T_est⁻¹)
-// lies within 3σ on every rotation / translation axis.
-void WriteExtrinsicEvaluation(const lioapp::RunSummary& run, std::ostream& ev) {
-  const bool perturbed =
-      run.true_extrinsic &&
-      (run.true_extrinsic->Matrix() - run.initial_extrinsic.Matrix()).norm() > 0.0;
-  if (!run.extrinsic_estimated && !perturbed) return;
-  ev << "extrinsic_estimated " << (run.extrinsic_estimated ? 1 : 0) << "\n";
-  const SE3& T = run.final_extrinsic;
-  const Eigen::Quaterniond q = T.quaternion();
-  ev << "extrinsic_final_xyz_qxyzw " << T.translation().x() << ' ' << T.translation().y() << ' '
-     << T.translation().z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w() << "\n";
-  if (run.extrinsic_estimated) {
-    const Vec6& s = run.final_extrinsic_sigma;
-    ev << "extrinsic_sigma_cm " << 100 * s[0] << ' ' << 100 * s[1] << ' ' << 100 * s[2]
-       << "\nextrinsic_sigma_deg " << s[3] * 180 / M_PI << ' ' << s[4] * 180 / M_PI << ' '
-       << s[5] * 180 / M_PI << "\n";
-  }
-  if (!run.true_extrinsic) return;
-  const sim::ExtrinsicErrorSize e0 =
-      sim::MeasureExtrinsicError(run.initial_extrinsic, *run.true_extrinsic);
-  const sim::ExtrinsicErrorSize e1 = sim::MeasureExtrinsicError(T, *run.true_extrinsic);
-  ev << "extrinsic_initial_error_deg " << e0.rotation_deg << "\nextrinsic_initial_error_cm "
-     << 100 * e0.translation_m << "\nextrinsic_error_deg " << e1.rotation_deg
-     << "\nextrinsic_error_cm " << 100 * e1.translation_m << "\n";
-  if (run.extrinsic_estimated) {
-    const sim::SigmaCoverage c =
-        sim::CoveredBySigma(T, *run.true_extrinsic, run.final_extrinsic_sigma);
-    ev << "extrinsic_translation_within_3sigma " << (c.translation ? 1 : 0)
-       << "\nextrinsic_rotation_within_3sigma " << (c.rotation ? 1 : 0) << "\n";
-  }
-}
-
 }  // namespace
 
 constexpr char kUsage[] =
@@ -349,7 +308,7 @@ int main(int argc, char** argv) {
     RequireInRange("sim_beams", FLAGS_sim_beams, 1, 4096);
     RequireInRange("sim_firing_decimation", FLAGS_sim_firing_decimation, 1, 1'000'000);
     RequireInRange("sim_lidar_rate", FLAGS_sim_lidar_rate, 0.1, 1000.0, " Hz");
-    const std::vector<std::string> methods = Split(FLAGS_method);
+    const std::vector<std::string> methods = SplitList(FLAGS_method);
     if (methods.empty()) throw std::runtime_error("--method is empty");
     lio::OdometryConfig base;
     // An `extrinsic:` written in the config wins over the dataset's (precedence:
@@ -385,7 +344,7 @@ int main(int argc, char** argv) {
       if (FLAGS_estimate_time_offset) config.calibration.estimate_time_offset = true;
       if (!FLAGS_time_offset.empty()) {
         config.calibration.time_offset_s.clear();
-        for (const std::string& d : Split(FLAGS_time_offset)) {
+        for (const std::string& d : SplitList(FLAGS_time_offset)) {
           config.calibration.time_offset_s.push_back(std::stod(d));
         }
       }
@@ -456,114 +415,20 @@ int main(int argc, char** argv) {
       files.Add(out + "/scans.log", "one line per scan: status, residuals, times [ms], degeneracy");
       const std::string ev_path = out + "/evaluation.txt";
       std::ofstream ev = io::OpenForWriting(ev_path);
-      ev << "source " << run.source << "\nmethod " << run.method << "\nscans " << run.scans.size()
-         << "\nfailed_scans " << run.failed << "\ndegenerate_scans " << run.degenerate
-         << "\ndegenerate_direction_scans " << run.degenerate_direction_scans << "\nimu_gap_scans "
-         << run.imu_gaps << "\nmedian_ms " << run.median_ms << "\np95_ms " << run.p95_ms
-         << "\nmax_ms " << run.max_ms << "\nmedian_cpu_ms " << run.median_cpu_ms << "\np95_cpu_ms "
-         << run.p95_cpu_ms << "\nmedian_preprocess_ms " << run.median_preprocess_ms
-         << "\nmedian_associate_ms " << run.median_associate_ms << "\nmedian_solve_ms "
-         << run.median_solve_ms << "\nmedian_map_ms " << run.median_map_ms
-         << "\nmedian_marginalize_ms " << run.median_marginalize_ms << "\npeak_rss_mb "
-         << run.peak_rss_kb / 1024.0 << "\nextrinsic_origin \"" << run.extrinsic_origin
-         << "\"\nimu_samples_rejected " << run.imu_rejected << "\npoints_dropped_out_of_interval "
-         << run.points_dropped << "\nscans_skipped " << run.scans_skipped << "\nconstant_imu_scans "
-         << run.constant_imu_scans << "\nlidar_gaps " << run.lidar_gaps << "\n";
-      if (run.lidar_gaps > 0) ev << "first_lidar_gap \"" << run.first_lidar_gap << "\"\n";
-      if (run.overlapping_scans > 0) {
-        ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
-           << run.first_overlapping_scan << "\"\n";
-      }
-      if (!run.extrinsic_disagreement.empty()) {
-        ev << "extrinsic_disagreement \"" << run.extrinsic_disagreement << "\"\n";
-      }
-      // An estimate the lidar never fixed has no ATE; the line says why (run_checks.h).
-      if (!run.unregistered_run.empty()) ev << "no_ate \"" << run.unregistered_run << "\"\n";
-      if (!run.first_input_warning.empty()) {
-        ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
-      }
-      if (!run.imu_note.empty()) ev << "imus \"" << run.imu_note << "\"\n";
-      for (size_t j = 0; j < run.final_biases.size() && run.true_biases.size() > 1; ++j) {
-        ev << "imu" << j << "_bias_estimate";
-        for (int k = 0; k < 6; ++k) ev << ' ' << run.final_biases[j][k];
-        if (j < run.true_biases.size() && run.true_biases[j]) {
-          ev << "\nimu" << j << "_bias_true";
-          for (int k = 0; k < 6; ++k) ev << ' ' << (*run.true_biases[j])[k];
-        }
-        ev << "\n";
-      }
-      WriteExtrinsicEvaluation(run, ev);
-      lioapp::WriteObservabilitySummary(run, recommended, ev);
-      if (!run.nees.empty()) {
-        ev << "nees_pose_mean " << lioapp::Mean(run.nees) << "\nnees_translation_mean "
-           << lioapp::Mean(run.nees_translation) << "\nnees_rotation_mean "
-           << lioapp::Mean(run.nees_rotation) << "\nnees_scans " << run.nees.size() << "\n";
-      }
+      const std::optional<std::vector<io::StampedPose>> truth = source->GroundTruth();
+      lioapp::WriteRunEvaluation(run, recommended, truth ? &*truth : nullptr, ev);
       if (run.ate) {
-        ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "
-           << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
-        // calibration.warmup_replay_s: the live output's ATE, before the replay revised its start.
-        ev << "warmup_replayed_scans " << run.warmup_replayed_scans << "\n";
-        if (run.live_ate) ev << "live_ate_rmse_m " << run.live_ate->rmse << "\n";
-        if (!run.dense.empty()) {
-          ev << "dense_ate_rmse_m " << lioapp::EvaluateAte(run.dense, *source->GroundTruth()).rmse
-             << "\ndense_poses " << run.dense.size() << "\n";
-        }
-        if (!run.dense_live.empty()) {
-          ev << "dense_live_ate_rmse_m "
-             << lioapp::EvaluateAte(run.dense_live, *source->GroundTruth()).rmse << "\n";
-        }
-        ev << "ate_alignment";
-        for (int r = 0; r < 4; ++r) {
-          for (int c = 0; c < 4; ++c)
-            ev << ' ' << std::setprecision(17) << run.ate->alignment(r, c);
-        }
-        ev << std::setprecision(6) << "\n";
-        io::WriteTum(out + "/ground_truth.tum", *source->GroundTruth());
+        io::WriteTum(out + "/ground_truth.tum", *truth);
         files.Add(out + "/ground_truth.tum", "the source's ground truth (TUM)");
-        lioapp::WritePoseErrors(out + "/pose_errors.csv", run.trajectory, *source->GroundTruth(),
+        lioapp::WritePoseErrors(out + "/pose_errors.csv", run.trajectory, *truth,
                                 run.ate->alignment);
         files.Add(out + "/pose_errors.csv", "per-pose position [m] and rotation [deg] error");
-        truths.push_back(*source->GroundTruth());
+        truths.push_back(*truth);
       } else {
         truths.emplace_back();
       }
       if (config.calibration.any()) {
-        lioapp::WriteCalibrationLog(out + "/calibration.csv", run);
-        files.Add(out + "/calibration.csv", "online calibration estimates and sigmas per scan");
-        // After a warm-up replay, the estimates it replaced, which the plot draws beside it.
-        if (!run.warmup_live_scans.empty()) {
-          lioapp::WriteCalibrationLog(out + "/calibration_live.csv", run, &run.warmup_live_scans);
-          files.Add(out + "/calibration_live.csv", "the estimates the warm-up replay replaced");
-        }
-        if (recommended) {
-          lioapp::WriteCalibrationYaml(out + "/calibration.yaml", run, *recommended);
-          files.Add(out + "/calibration.yaml", "the calibration to use in the next --config");
-        }
-        if (recommended && !recommended->kept_at_start.empty()) {
-          std::string names;
-          for (const std::string& n : recommended->kept_at_start) {
-            names += " " + n;
-          }
-          LOG(WARNING) << "Calibration: sigma not below the threshold (the data did not inform "
-                          "them), written at their start values in "
-                       << out << "/calibration.yaml:" << names;
-        }
-        if (const lio::ScanResult* last = lioapp::LastCalibration(run)) {
-          const auto& c = last->calibration;
-          for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
-            ev << "imu" << j << "_time_offset_s " << std::setprecision(9) << c.time_offset_s[j]
-               << "\nimu" << j << "_time_offset_sigma_s "
-               << (j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN) << "\n";
-            if (j < run.true_time_offsets.size() && run.true_time_offsets[j]) {
-              ev << "imu" << j << "_time_offset_true_s " << *run.true_time_offsets[j] << "\nimu"
-                 << j << "_time_offset_error_s " << c.time_offset_s[j] - *run.true_time_offsets[j]
-                 << "\n";
-            }
-          }
-          ev << std::setprecision(6);
-          // (The extrinsic's lines follow here.)
-        }
+        lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
       if (FLAGS_write_bag) {
         io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
@@ -616,65 +481,7 @@ int main(int argc, char** argv) {
     if (folders.size() > 1 && made(FLAGS_out + "/comparison.png")) {
       files.Add(FLAGS_out + "/comparison.png", "plot: the methods side by side");
     }
-    std::printf("\n%-12s %8s %8s %8s %13s %6s %6s %10s %9s\n", "method", "ATE[m]", "mean[m]",
-                "max[m]", "drift[m/100m]", "scans", "failed", "degenerate", "degen_dir");
-    for (const auto& r : runs) {
-      if (r.ate) {
-        std::printf("%-12s %8.4f %8.4f %8.4f", r.method.c_str(), r.ate->rmse, r.ate->mean,
-                    r.ate->max);
-      } else {
-        std::printf("%-12s %8s %8s %8s", r.method.c_str(), "-", "-", "-");
-      }
-      char drift[32] = "-";
-      if (r.drift_per_100m) std::snprintf(drift, sizeof(drift), "%.3f", *r.drift_per_100m);
-      std::printf(" %13s %6zu %6d %10d %9d\n", drift, r.scans.size(), r.failed, r.degenerate,
-                  r.degenerate_direction_scans);
-    }
-    std::printf(
-        "  degenerate: scans with status `degenerate` (evaluation.txt degenerate_scans):\n"
-        "    the lidar did not fix the pose (too few associations, or lidar_only along a\n"
-        "    degenerate direction)\n"
-        "  degen_dir: scans whose lidar term had a degenerate direction, whatever their\n"
-        "    status (with an IMU they stay `ok`; evaluation.txt degenerate_direction_scans,\n"
-        "    scans.log degen_dirs)\n");
-    std::printf("\nTime per scan [ms] (the first scan, which starts the map, excluded):\n");
-    std::printf("%-12s %8s %8s %8s %8s %10s %10s %9s %8s %8s %9s\n", "method", "wall_med",
-                "wall_p95", "cpu_med", "cpu_p95", "preprocess", "associate", "solve", "map",
-                "marginal", "peak[MB]");
-    for (const auto& r : runs) {
-      std::printf("%-12s %8.1f %8.1f %8.1f %8.1f %10.1f %10.1f %9.1f %8.1f %8.1f %9.1f\n",
-                  r.method.c_str(), r.median_ms, r.p95_ms, r.median_cpu_ms, r.p95_cpu_ms,
-                  r.median_preprocess_ms, r.median_associate_ms, r.median_solve_ms, r.median_map_ms,
-                  r.median_marginalize_ms, r.peak_rss_kb / 1024.0);
-    }
-    std::printf(
-        "  (preprocess ... marginal: medians of the wall-time split; peak: resident memory)\n");
-    for (const auto& r : runs) {
-      if (r.imu_rejected + r.points_dropped + r.scans_skipped + r.constant_imu_scans > 0) {
-        std::printf(
-            "  %-10s input: %d IMU samples rejected, %d points dropped, %d scans skipped, %d scans "
-            "with a frozen IMU (first: %s)\n",
-            r.method.c_str(), r.imu_rejected, r.points_dropped, r.scans_skipped,
-            r.constant_imu_scans, r.first_input_warning.c_str());
-      }
-    }
-    for (const auto& r : runs) {
-      if (!r.unregistered_run.empty()) {
-        std::printf("  %-10s FAILED, no ATE: %s\n", r.method.c_str(), r.unregistered_run.c_str());
-      }
-      if (r.lidar_gaps > 0) {
-        std::printf("  %-10s lidar: %d gap(s) over 3x the median scan period (first: %s)\n",
-                    r.method.c_str(), r.lidar_gaps, r.first_lidar_gap.c_str());
-      }
-      if (r.overlapping_scans > 0) {
-        std::printf("  %-10s WARNING %d scan(s) begin before the previous scan's end (first: %s)\n",
-                    r.method.c_str(), r.overlapping_scans, r.first_overlapping_scan.c_str());
-      }
-      if (!r.extrinsic_disagreement.empty()) {
-        std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),
-                    r.extrinsic_disagreement.c_str());
-      }
-    }
+    lioapp::PrintRunTables(runs);
     std::printf("\n");
     std::ostringstream listing;
     files.Print(listing);

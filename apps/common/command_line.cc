@@ -76,6 +76,18 @@ void PrintFlags(const std::vector<gflags::CommandLineFlagInfo>& flags, std::ostr
   }
 }
 
+std::vector<std::string> SplitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!item.empty()) {
+      out.push_back(item);
+    }
+  }
+  return out;
+}
+
 void ParseCommandLine(int* argc, char*** argv, const char* usage) {
   gflags::SetUsageMessage(usage);
   const std::string program = ProgramName(*argc > 0 ? (*argv)[0] : nullptr);

@@ -37,6 +37,9 @@ std::vector<gflags::CommandLineFlagInfo> OwnFlags();
 // 100 columns.
 void PrintFlags(const std::vector<gflags::CommandLineFlagInfo>& flags, std::ostream& os);
 
+// The items of a comma-separated flag value ("singer_lio,imu_input"), empty items skipped.
+std::vector<std::string> SplitList(const std::string& s);
+
 // The largest thread count a flag or config key may ask for (window.threads and
 // lidar_frontend.threads have the same bound): far above the cores of any machine the programs run
 // on, far below the threads a process may create.

@@ -12,6 +12,7 @@
 
 #include "ctlio/io/dataset.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "trajectory_errors.h"
 
 namespace ctlio::lioapp {
 
@@ -38,14 +39,6 @@ struct RunOptions {
   // frame of RunSummary::trajectory: a map starts over there (the warm-up's live points were
   // placed with the calibration the replay revised, a 3° extrinsic error puts them metres off).
   std::function<void(const lio::ScanResult&, const std::vector<Vec3>&)> map_points;
-};
-
-struct AteResult {
-  double rmse = 0.0;  // m, after SE(3) Umeyama alignment
-  double mean = 0.0;
-  double max = 0.0;
-  size_t pairs = 0;
-  Eigen::Matrix4d alignment = Eigen::Matrix4d::Identity();  // estimate → truth frame
 };
 
 struct RunSummary {
@@ -138,8 +131,6 @@ struct RunSummary {
   bool failure = false;
 };
 
-inline constexpr double kDriftWindow = 10.0;  // m
-
 RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                        const RunOptions& options = {}, double failure_ate = 1.0);
 
@@ -156,36 +147,6 @@ void ImusFromSource(const io::DataSource& source, lio::OdometryConfig* config);
 
 // Mean of `v` (NaN if empty).
 double Mean(const std::vector<double>& v);
-
-// ATE of `estimate` against `truth` (time association within 1 ms; truth interpolated between
-// its two nearest poses), SE(3) Umeyama alignment.
-AteResult EvaluateAte(const std::vector<io::StampedPose>& estimate,
-                      const std::vector<io::StampedPose>& truth);
-
-// RunSummary::drift_per_100m of `estimate` against `truth` (nullopt: path < 1 m).
-std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
-                                   const std::vector<io::StampedPose>& truth);
-
-// Per-pose errors against the truth after `alignment` (estimate → truth frame), CSV:
-// t_s, aligned estimate x y z, truth x y z, position error [m], rotation error [deg]: the angle of
-// the rotation drift since the first pose, (C_t0ᵀ C_t)ᵀ (C_e0ᵀ C_e), with the truth rotation of the
-// nearest truth pose. Poses outside the truth are left out. Read by tools/plot_odometry.py.
-void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
-                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
-
-// Per-scan log (the write is checked: an error names the path): t, status, keypoints,
-// associations, imu residuals, rounds, solver iterations, final cost, ms (total and per stage),
-// CPU ms, position, IMU samples rejected, points dropped, the degeneracy analysis (normalised
-// smallest eigenvalue of the translation and rotation blocks, number of degenerate directions,
-// the least constrained one "t:x,y,z"/"r:x,y,z" in the body frame, the lidar's and the prior's
-// information along it; "-" where not analysed), message.
-void WriteScanLog(const std::string& path, const RunSummary& run);
-
-// Top view (x–y) of the ground truth (grey) and the aligned estimate (red) as an SVG file with
-// axes in metres and the title wrapped: the fallback when matplotlib is missing.
-void WriteTopViewSvg(const std::string& path, const std::vector<io::StampedPose>& estimate,
-                     const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment,
-                     const std::string& title);
 
 long PeakRssKb();
 double Percentile(std::vector<double> v, double p);
