@@ -256,13 +256,17 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
 
 // --python, else the first of python3, /usr/bin/python3 with matplotlib; empty if none.
 std::string PythonWithMatplotlib() {
-  std::string python = FLAGS_python;
-  for (const char* p : {"python3", "/usr/bin/python3"}) {
-    if (!python.empty()) break;
-    const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
-    if (std::system(probe.c_str()) == 0) python = p;
-  }
-  return python;
+  // Probed once per process: each probe starts a python (the plots and every method's map ask).
+  static const std::string found = [] {
+    std::string python = FLAGS_python;
+    for (const char* p : {"python3", "/usr/bin/python3"}) {
+      if (!python.empty()) break;
+      const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
+      if (std::system(probe.c_str()) == 0) python = p;
+    }
+    return python;
+  }();
+  return found;
 }
 
 // Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
