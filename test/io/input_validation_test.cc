@@ -35,6 +35,7 @@
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/ros_wire_check.h"
 #include "ctlio/io/rosbag_source.h"
+#include "io/small_pointcloud2.h"
 
 namespace ctlio::io {
 namespace {
@@ -47,18 +48,7 @@ constexpr int64_t kStamp = 200'000'000;  // 0.2 s
 
 // 10 points x y z float32 + t uint32 (16 B), t = 0, 1 … 9 µs after the stamp.
 sensor_msgs::PointCloud2 GoodCloud(int64_t stamp_ns = kStamp, int n = 10) {
-  PointCloud c;
-  c.stamp_ns = stamp_ns;
-  for (int i = 0; i < n; ++i) {
-    c.points.emplace_back(1.0 + i, 2.0, 0.5);
-    c.times_ns.push_back(stamp_ns + i * 1000);
-  }
-  TimeConvention t;
-  t.field = "t";
-  return EncodePointCloud2(
-      c,
-      {{"x", kFloat32, 0, 1}, {"y", kFloat32, 4, 1}, {"z", kFloat32, 8, 1}, {"t", kUInt32, 12, 1}},
-      16, t, "lidar");
+  return testing::SmallPointCloud2(stamp_ns, n);
 }
 
 struct TfEdge {

@@ -30,6 +30,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/io/warning_limiter.h"
+#include "io/small_pointcloud2.h"
 
 namespace ctlio::io {
 namespace {
@@ -40,20 +41,7 @@ using ::ctlio::testing::ExpectError;
 using ::ctlio::testing::WarningSink;
 
 // 10 points, times 0 … 9 µs after the stamp (x y z float32, t uint32).
-sensor_msgs::PointCloud2 Cloud(int64_t stamp_ns) {
-  PointCloud c;
-  c.stamp_ns = stamp_ns;
-  for (int i = 0; i < 10; ++i) {
-    c.points.emplace_back(1.0 + i, 2.0, 0.5);
-    c.times_ns.push_back(stamp_ns + i * 1000);
-  }
-  TimeConvention t;
-  t.field = "t";
-  return EncodePointCloud2(
-      c,
-      {{"x", kFloat32, 0, 1}, {"y", kFloat32, 4, 1}, {"z", kFloat32, 8, 1}, {"t", kUInt32, 12, 1}},
-      16, t, "lidar");
-}
+sensor_msgs::PointCloud2 Cloud(int64_t stamp_ns) { return testing::SmallPointCloud2(stamp_ns); }
 
 // A bag with clouds at 0.2, 0.3, 0.4 s, the IMU at the given stamps, and ground-truth poses
 // (qw qx qy qz x y z) at 0.1 s, 0.2 s, ... on /ground_truth.
