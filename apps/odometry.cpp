@@ -110,7 +110,8 @@ DEFINE_bool(strict, false,
             "Every documented recovery of a reader or of the input gates (duplicate IMU samples "
             "dropped, unusable scans handed on, points dropped, scans retimed or skipped, IMU "
             "gaps, IMU samples rejected) is an error naming the defect; for pipelines that must "
-            "not guess (docs/user-guide/bad-input.md)");
+            "not guess (docs/user-guide/bad-input.md). Given explicitly it wins over input.strict "
+            "of --config");
 DEFINE_bool(progress, true, "Show progress on stderr");
 DEFINE_double(play_rate, 0.0,
               "Give each scan to the odometry at its own time on the wall clock, sped up by this "
@@ -353,7 +354,10 @@ int main(int argc, char** argv) {
         }
       }
       config.Validate();
-      ctlio::io::WarningLimiter::SetStrict(FLAGS_strict);  // before the readers read anything
+      // Before the readers read anything; --strict given explicitly wins over input.strict.
+      ctlio::io::WarningLimiter::SetStrict(
+          gflags::GetCommandLineFlagInfoOrDie("strict").is_default ? config.input.strict
+                                                                   : FLAGS_strict);
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);

@@ -79,6 +79,11 @@ void WriteRunEvaluation(const RunSummary& run,
   if (!run.first_input_warning.empty()) {
     ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
   }
+  // The reader's recoveries: a run that exits 0 after them says what was recovered from.
+  if (!run.input_defects.empty()) ev << "input_defect_kinds " << run.input_defects.size() << "\n";
+  for (const io::InputDefect& d : run.input_defects) {
+    ev << "input_defect \"" << d.kind << "\" " << d.count << " \"" << d.first << "\"\n";
+  }
   if (!run.imu_note.empty()) ev << "imus \"" << run.imu_note << "\"\n";
   for (size_t j = 0; j < run.final_biases.size() && run.true_biases.size() > 1; ++j) {
     ev << "imu" << j << "_bias_estimate";
@@ -217,6 +222,10 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),
                   r.extrinsic_disagreement.c_str());
+    }
+    for (const io::InputDefect& d : r.input_defects) {
+      std::printf("  %-10s WARNING input: %zu x %s (first: %s)\n", r.method.c_str(), d.count,
+                  d.kind.c_str(), d.first.c_str());
     }
   }
 }

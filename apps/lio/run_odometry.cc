@@ -399,6 +399,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     run.live_ate.reset();
     run.drift_per_100m.reset();
   }
+  run.input_defects = source.InputDefects();
   const LidarGaps gaps = FindLidarGaps(scan_ends);
   run.lidar_gaps = gaps.count;
   run.first_lidar_gap = gaps.first;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ctlio/io/dataset.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "trajectory_errors.h"
 
@@ -83,8 +84,11 @@ struct RunSummary {
   // runner: what follows from them (a failed gravity initialisation, points dropped out of the
   // interval) names its own symptom, not this cause.
   int overlapping_scans = 0;
-  std::string first_overlapping_scan;                  // the first one's warning
-  std::string first_input_warning;                     // message of the first of the above
+  std::string first_overlapping_scan;  // the first one's warning
+  std::string first_input_warning;     // message of the first of the above
+  // The reader's recoveries (DataSource::InputDefects: duplicate IMU times, IMU gaps, points
+  // outside their sweep, re-timed sweeps, unusable scans), one entry per kind.
+  std::vector<io::InputDefect> input_defects;
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
   double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan
   // Medians over the scans of the wall-time split (ScanResult::ms_*).

@@ -146,6 +146,33 @@ TEST(WarningLimiter, TenThousandDuplicateImuStampsInACsvLogAFewLinesAndATotal) {
   EXPECT_LE(sink.lines().size(), 10u);
 }
 
+TEST(WarningLimiter, DefectsListEachKindWithItsCountAndFirstPlace) {
+  WarningLimiter limiter("seq");
+  limiter.Count("IMU gap", "imu.csv:9");
+  limiter.Count("IMU gap", "imu.csv:40");
+  limiter.Count("unusable scan");
+  const std::vector<InputDefect> d = limiter.Defects();
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].kind, "IMU gap");
+  EXPECT_EQ(d[0].count, 2u);
+  EXPECT_EQ(d[0].first, "imu.csv:9");  // the first place, not the last
+  EXPECT_EQ(d[1].kind, "unusable scan");
+  EXPECT_EQ(d[1].first, "seq");  // without a detail: the source
+}
+
+TEST(InputDefects, AReaderReportsTheImuStreamsRecoveriesItsCheckCounted) {
+  std::vector<ImuSample> imu(6);
+  for (int i = 0; i < 6; ++i) imu[i].t_ns = int64_t(i < 3 ? i : i - 1) * 5'000'000;  // 2 = 3
+  WarningLimiter reader("seq");
+  CheckImuStream("imu.csv", {2, 3, 4, 5, 6, 7}, 0, &imu, &reader);
+  EXPECT_EQ(imu.size(), 5u);
+  const std::vector<InputDefect> d = reader.Defects();
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_EQ(d[0].kind, "duplicate IMU time");
+  EXPECT_EQ(d[0].count, 1u);
+  EXPECT_EQ(d[0].first, "imu.csv:5");
+}
+
 TEST(WarningLimiter, ManyImuGapsInABagLogAFewLinesAndATotal) {
   const fs::path d = testing::FreshTempDir("limiter_bag");
   // 100 gaps of 0.2 s in a 10 ms IMU (the bag warns above 0.1 s).

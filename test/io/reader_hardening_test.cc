@@ -14,6 +14,7 @@
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 
 namespace ctlio::io {
@@ -252,6 +253,30 @@ TEST(ReaderHardening, NewerCollegeWriterRefusesAnExtrinsicTheLayoutCannotCarry) 
   const fs::path d = testing::FreshTempDir("harden_extrinsic");
   ExpectError([&] { WriteNewerCollege(source, d.string()); },
               {d.string(), "published T_imu_lidar"});
+}
+
+// Issue 40: a folder reader hands on what it recovered from (DataSource::InputDefects), so that
+// the run reports it in evaluation.txt: none for a clean folder, the duplicate for one with an IMU
+// line repeated, with the line of the first.
+TEST(InputDefects, AFolderReaderHandsOnWhatItRecoveredFrom) {
+  const fs::path d = CtlioFixture("defects");
+  EXPECT_TRUE(SimFolderReader(d.string()).InputDefects().empty());
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(d / "imu.csv");
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  lines.insert(lines.begin() + 10, lines[10]);  // line 12 repeats line 11
+  {
+    std::ofstream out(d / "imu.csv");
+    for (const auto& l : lines) out << l << "\n";
+  }
+  SimFolderReader reader(d.string());
+  const std::vector<InputDefect> defects = reader.InputDefects();
+  ASSERT_EQ(defects.size(), 1u);
+  EXPECT_EQ(defects[0].kind, "duplicate IMU time");
+  EXPECT_EQ(defects[0].count, 1u);
+  EXPECT_NE(defects[0].first.find("imu.csv:12"), std::string::npos) << defects[0].first;
 }
 
 }  // namespace

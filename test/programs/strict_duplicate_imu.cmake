@@ -1,6 +1,7 @@
 cmake_minimum_required(VERSION 3.25)
 # ctlio_odometry --strict (issue 40): a ctlio folder whose imu.csv repeats one line is recovered
-# without it (the duplicate dropped, exit 0) and refused with it (exit non-zero, the defect and the
+# without it (the duplicate dropped, exit 0, reported in evaluation.txt and the summary) and
+# refused with it (exit non-zero, the defect and the
 # file named).
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -26,6 +27,16 @@ endif()
 string(FIND "${err}" "duplicate IMU time" at)
 if(at EQUAL -1)
   message(FATAL_ERROR "without --strict the duplicate is not logged:\n${err}")
+endif()
+# The recovery is in the run's outputs too, not only in the log (DataSource::InputDefects).
+file(READ ${WORK}/lenient/evaluation.txt ev)
+string(FIND "${ev}" "input_defect \"duplicate IMU time\" 1 \"${WORK}/s/imu.csv:102\"" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "evaluation.txt does not report the recovered duplicate:\n${ev}")
+endif()
+string(FIND "${out}" "WARNING input: 1 x duplicate IMU time" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "the summary does not report the recovered duplicate:\n${out}")
 endif()
 execute_process(COMMAND ${run} --strict --out=${WORK}/strict RESULT_VARIABLE rc OUTPUT_VARIABLE out
                 ERROR_VARIABLE err TIMEOUT 300)

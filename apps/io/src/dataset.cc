@@ -84,12 +84,16 @@ size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, 
   return n - kept;
 }
 
+std::vector<InputDefect> DataSource::InputDefects() const { return {}; }
+
 void CheckImuStream(const std::string& path, const std::vector<int>& lines,
-                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu) {
+                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu,
+                    WarningLimiter* warnings) {
   std::vector<ImuSample> kept;
   kept.reserve(imu->size());
   size_t duplicates = 0;
-  WarningLimiter limiter(path);  // the first few of each kind in full, then totals
+  WarningLimiter own(path);  // the first few of each kind in full, then totals
+  WarningLimiter& limiter = warnings != nullptr ? *warnings : own;
   for (size_t i = 0; i < imu->size(); ++i) {
     const ImuSample& s = (*imu)[i];
     const int line = i < lines.size() ? lines[i] : 0;
@@ -139,7 +143,7 @@ void CheckImuStream(const std::string& path, const std::vector<int>& lines,
                    << 1e-9 * double(median) << " s); samples handed on";
     }
   }
-  limiter.LogTotals();
+  own.LogTotals();
 }
 
 bool ParseSecondsNs(const std::string& s, int64_t* ns) {

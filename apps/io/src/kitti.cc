@@ -188,4 +188,6 @@ std::optional<std::vector<StampedPose>> KittiReader::GroundTruth() const {
   return ground_truth_;
 }
 
+std::vector<InputDefect> KittiReader::InputDefects() const { return warnings_->Defects(); }
+
 }  // namespace ctlio::io

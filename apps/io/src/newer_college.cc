@@ -116,7 +116,7 @@ NewerCollegeReader::NewerCollegeReader(const std::string& folder,
     lines.push_back(row.line);
   }
   if (imu_.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
-  CheckImuStream(imu_path, lines, options_.max_imu_gap_error_ns, &imu_);
+  CheckImuStream(imu_path, lines, options_.max_imu_gap_error_ns, &imu_, warnings_.get());
 
   const std::string gt_path = GtFile(seq).string();
   std::error_code ec;
@@ -254,5 +254,7 @@ size_t WriteNewerCollege(DataSource& source, const std::string& folder,
   }
   return n;
 }
+
+std::vector<InputDefect> NewerCollegeReader::InputDefects() const { return warnings_->Defects(); }
 
 }  // namespace ctlio::io

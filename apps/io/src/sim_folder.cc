@@ -205,7 +205,7 @@ SimFolderReader::SimFolderReader(const std::string& folder, int64_t max_imu_gap_
       lines.push_back(row.line);
     }
     if (imu.empty()) throw std::runtime_error(imu_path + ": no IMU samples");
-    CheckImuStream(imu_path, lines, max_imu_gap_error_ns, &imu);
+    CheckImuStream(imu_path, lines, max_imu_gap_error_ns, &imu, warnings_.get());
     streams.push_back(std::move(imu));
   }
   imu_ = MergeImuStreams(streams);
@@ -368,5 +368,7 @@ size_t WriteSimFolder(DataSource& source, const std::string& folder, const std::
   }
   return n;
 }
+
+std::vector<InputDefect> SimFolderReader::InputDefects() const { return warnings_->Defects(); }
 
 }  // namespace ctlio::io

@@ -308,7 +308,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"moving_translation", SetFromYaml(&o.moving_translation)},
                    {"moving_rotation", SetFromYaml(&o.moving_rotation)},
                    {"scan_time_tolerance", SetFromYaml(&o.scan_time_tolerance)},
-                   {"max_imu_gap_error", SetFromYaml(&o.max_imu_gap_error)}});
+                   {"max_imu_gap_error", SetFromYaml(&o.max_imu_gap_error)},
+                   {"strict", SetFromYaml(&o.strict)}});
     } else {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + section +
                                "'");

@@ -325,6 +325,7 @@ SE3 RosbagSource::ImuFromLidar() const {
 }
 
 std::string RosbagSource::ExtrinsicOrigin() const { return impl_->extrinsic_origin; }
+std::vector<InputDefect> RosbagSource::InputDefects() const { return impl_->warnings->Defects(); }
 
 std::optional<std::vector<StampedPose>> RosbagSource::GroundTruth() const {
   if (impl_->ground_truth.empty()) return std::nullopt;

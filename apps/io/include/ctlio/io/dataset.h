@@ -57,6 +57,8 @@ struct ScanFrame {
   std::vector<ImuSample> imu;
 };
 
+struct InputDefect;  // warning_limiter.h
+
 class DataSource {
  public:
   virtual ~DataSource() = default;
@@ -81,6 +83,10 @@ class DataSource {
   // The IMUs whose samples the scans carry (ImuSample::imu indexes this list); one IMU in the
   // body frame unless the source says otherwise.
   virtual std::vector<ImuInfo> Imus() const { return {ImuInfo{}}; }
+  // The input defects the reader recovered from so far (warning_limiter.h: duplicate IMU times,
+  // IMU gaps, points outside their sweep, re-timed sweeps, unusable scans, ...), one entry per
+  // kind; the runner writes them into evaluation.txt. Sources without recoveries: none.
+  virtual std::vector<InputDefect> InputDefects() const;
 };
 
 // The samples of several time-sorted IMU streams in one time-sorted list, each sample tagged
@@ -106,14 +112,16 @@ size_t DropPointsOutside(const std::string& path, int64_t lo_ns, int64_t hi_ns, 
                          WarningLimiter* warnings = nullptr);
 
 // Checks an IMU stream read from `path` (lines[i] = line number of imu[i]) and applies the
-// documented recoveries, logged with glog:
+// documented recoveries, logged with glog and counted in `warnings` (the reader's limiter, whose
+// InputDefects the run reports; null: a limiter of its own):
 //   * a sample with the same time as the previous one (duplicate) is dropped, with a warning;
 //   * a time going backwards is an error "<path>:<line>: IMU time goes backwards ...";
 //   * a gap (spacing above 3× the median) is a warning "<path>:<line>: gap of ... s in the IMU"
 //     and the samples are handed on; with `max_gap_error_ns` > 0 a gap longer than that is an
 //     error "<path>:<line>: gap of ... in the IMU" (opt-in: --max_imu_gap_error).
 void CheckImuStream(const std::string& path, const std::vector<int>& lines,
-                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu);
+                    int64_t max_gap_error_ns, std::vector<ImuSample>* imu,
+                    WarningLimiter* warnings = nullptr);
 
 // Decimal seconds (as in TUM files) to int64 ns without going through double, so that
 // 1583836591.182590000 stays exact. Returns false if `s` is not a decimal number.

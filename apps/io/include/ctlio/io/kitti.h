@@ -26,6 +26,7 @@ class KittiReader : public DataSource {
   std::string Name() const override { return "kitti:" + folder_; }
   size_t NumScans() const override { return scans_.size(); }
   bool Next(ScanFrame* frame) override;
+  std::vector<InputDefect> InputDefects() const override;
   SE3 ImuFromLidar() const override { return SE3(); }
   std::optional<std::vector<StampedPose>> GroundTruth() const override;
 

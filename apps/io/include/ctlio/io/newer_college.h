@@ -45,6 +45,7 @@ class NewerCollegeReader : public DataSource {
   std::string Name() const override { return "newer_college:" + folder_; }
   size_t NumScans() const override { return scans_.size(); }
   bool Next(ScanFrame* frame) override;
+  std::vector<InputDefect> InputDefects() const override;
   SE3 ImuFromLidar() const override { return options_.imu_from_lidar; }
   std::optional<std::vector<StampedPose>> GroundTruth() const override;
   const std::vector<ImuSample>& imu() const { return imu_; }

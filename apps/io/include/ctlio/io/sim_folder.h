@@ -30,6 +30,7 @@ class SimFolderReader : public DataSource {
   std::string Name() const override { return "ctlio_sim:" + folder_; }
   size_t NumScans() const override { return scans_.size(); }
   bool Next(ScanFrame* frame) override;
+  std::vector<InputDefect> InputDefects() const override;
   SE3 ImuFromLidar() const override { return imu_from_lidar_; }
   std::optional<SE3> TrueImuFromLidar() const override { return true_imu_from_lidar_; }
   std::optional<std::vector<StampedPose>> GroundTruth() const override;

@@ -13,8 +13,18 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace ctlio::io {
+
+// One kind of recovered input defect of a run: how many times a reader recovered from it and
+// where the first one was. Readers hand these on (DataSource::InputDefects) so that a run that
+// exits 0 after recoveries says so in evaluation.txt, not only in a log nobody keeps.
+struct InputDefect {
+  std::string kind;  // "duplicate IMU time", "points outside the scan interval", ...
+  size_t count = 0;
+  std::string first;  // where the first one was: file and line, bag message, the reader's text
+};
 
 class WarningLimiter {
  public:
@@ -40,7 +50,15 @@ class WarningLimiter {
                                " (--strict: a defect that would be recovered "
                                "is an error; run without it to recover and log)");
     }
+    if (!first_.count(kind)) first_[kind] = detail.empty() ? source_ : detail;
     return ++counts_[kind] <= shown_;
+  }
+
+  // Every kind counted so far, in kind order.
+  std::vector<InputDefect> Defects() const {
+    std::vector<InputDefect> out;
+    for (const auto& [kind, n] : counts_) out.push_back({kind, n, first_.at(kind)});
+    return out;
   }
 
   size_t count(const std::string& kind) const {
@@ -69,6 +87,7 @@ class WarningLimiter {
   std::string source_;
   size_t shown_;
   std::map<std::string, size_t> counts_, reported_;
+  std::map<std::string, std::string> first_;
 };
 
 }  // namespace ctlio::io

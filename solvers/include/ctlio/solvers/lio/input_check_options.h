@@ -18,6 +18,10 @@ struct InputCheckOptions {
   // gaps are warnings and the odometry bridges them (it flags the scans by
   // OdometryConfig::max_imu_gap).
   double max_imu_gap_error = 0.0;  // s
+  // Strict input (docs/user-guide/bad-input.md): every recovery of the readers and of these gates
+  // is an error naming the defect, for pipelines that must not guess. ctlio_odometry --strict
+  // (given explicitly) wins over it; programs apply it with io::WarningLimiter::SetStrict.
+  bool strict = false;
 
   void Validate() const;  // throws std::invalid_argument naming the field
 };

@@ -68,6 +68,7 @@ class RosbagSource : public DataSource {
   SE3 ImuFromLidar() const override;
   std::string ExtrinsicOrigin() const override;
   std::optional<std::vector<StampedPose>> GroundTruth() const override;
+  std::vector<InputDefect> InputDefects() const override;
   const std::string& lidar_topic() const;
   const std::string& imu_topic() const;
   // Bytes of message data read so far (for throughput reports).

@@ -1,0 +1,418 @@
+#!/usr/bin/env python3
+"""Bad-input probe: mutates a short simulated recording in the ways real recordings go wrong and
+runs ctlio_odometry on each mutant (docs/user-guide/bad-input.md).
+
+Each run is classified:
+  error            exit != 0 with a message that names the input (file, flag or key)
+  run_failed       exit != 0 after the run: evaluation.txt written, the run reported failed
+  error_unnamed    exit != 0, the message names no input (a finding)
+  warned           exit 0 and evaluation.txt reports the defect (a count or a warning line)
+  accurate         exit 0, no warning, ATE within 3x the clean run's (the defect did no harm)
+  crash            killed by a signal (a finding)
+  hang             no exit within the timeout (a finding)
+  nan_exit0        exit 0 with NaN or Inf in the trajectory or the ATE (a finding)
+  silent_wrong     exit 0, ATE above 3x the clean run's, no warning in evaluation.txt (a finding)
+  memory           peak resident memory above 1 GB (a finding)
+The findings are the outcomes the bad-input promise rules out ("never crashes, never lies").
+
+  python3 tools/bad_input_probe.py --build build-test --out /tmp/probe [--seed 7] [--only imu]
+
+Writes <out>/probe.csv (one line per mutant) and prints the count per class and outcome.
+The mutants are drawn from --seed; a different seed gives mutants the tests never saw.
+"""
+import argparse
+import csv
+import math
+import os
+import random
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import time
+
+FINDINGS = {"error_unnamed", "crash", "hang", "nan_exit0", "silent_wrong", "memory"}
+WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
+                 "points_dropped_out_of_interval", "scans_skipped", "constant_imu_scans",
+                 "lidar_gaps", "overlapping_scans")
+WARN_KEYS = ("first_input_warning", "extrinsic_disagreement", "no_ate", "first_lidar_gap",
+             "input_defect")
+
+
+# ---------------------------------------------------------------- folder helpers
+def read_lines(path):
+    with open(path) as f:
+        return f.read().splitlines()
+
+
+def write_lines(path, lines):
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def map_csv(path, fn):
+    """fn(header, rows) -> rows; rows are lists of strings."""
+    lines = read_lines(path)
+    rows = [l.split(",") for l in lines[1:] if l]
+    write_lines(path, [lines[0]] + [",".join(r) for r in fn(lines[0], rows)])
+
+
+def map_points(path, fn):
+    """fn(list of [x, y, z, t]) -> list; 16-byte records float32 x y z, uint32 t."""
+    data = open(path, "rb").read()
+    pts = [list(struct.unpack_from("<fffI", data, i)) for i in range(0, len(data) // 16 * 16, 16)]
+    pts = fn(pts)
+    with open(path, "wb") as f:
+        for x, y, z, t in pts:
+            f.write(struct.pack("<fffI", x, y, z, int(t) & 0xFFFFFFFF))
+
+
+def scan_files(folder):
+    d = os.path.join(folder, "scans")
+    return sorted(os.path.join(d, f) for f in os.listdir(d))
+
+
+def edit_yaml(folder, old_re, new):
+    p = os.path.join(folder, "ctlio_sim.yaml")
+    s = open(p).read()
+    s2 = re.sub(old_re, new, s, count=1)
+    assert s2 != s, old_re
+    open(p, "w").write(s2)
+
+
+# ---------------------------------------------------------------- mutations (class, name, fn)
+def folder_mutations(rng):
+    m = []
+
+    def imu(fn):
+        return lambda d: map_csv(os.path.join(d, "imu.csv"), fn)
+
+    # imu_values
+    for bad in ("nan", "inf", "-inf", "1e300"):
+        col, row = rng.randrange(1, 7), rng.randrange(5, 700)
+        m.append(("imu_values", f"{bad}_col{col}_row{row}",
+                  imu(lambda h, r, bad=bad, col=col, row=row: [
+                      x if i != row else x[:col] + [bad] + x[col + 1:]
+                      for i, x in enumerate(r)])))
+    # imu_times
+    m.append(("imu_times", "duplicates", imu(lambda h, r: [x for x in r for _ in (0, 1)])))
+    swap = rng.randrange(5, 700)
+    m.append(("imu_times", f"swap_rows_{swap}",
+              imu(lambda h, r: r[:swap] + [r[swap + 1], r[swap]] + r[swap + 2:])))
+    m.append(("imu_times", "microseconds",
+              imu(lambda h, r: [[str(int(x[0]) // 1000)] + x[1:] for x in r])))
+    m.append(("imu_times", "gap_1s", imu(lambda h, r: [x for x in r if not
+                                                         1.5e9 <= int(x[0]) < 2.5e9])))
+    m.append(("imu_times", "rate_20hz", imu(lambda h, r: r[::10])))
+    m.append(("imu_times", "ends_early", imu(lambda h, r: r[:len(r) // 2])))
+    m.append(("imu_times", "near_int64_max",
+              imu(lambda h, r: [[str(int(x[0]) + 9223372030000000000)] + x[1:] for x in r])))
+    # imu_units
+    m.append(("imu_units", "accel_in_g", imu(lambda h, r: [x[:4] + [str(float(v) / 9.80665)
+                                                                     for v in x[4:]] for x in r])))
+    m.append(("imu_units", "accel_sign_flipped",
+              imu(lambda h, r: [x[:4] + [str(-float(v)) for v in x[4:]] for x in r])))
+    m.append(("imu_units", "gyro_deg_per_s", imu(lambda h, r: [[x[0]] + [str(float(v) * 57.29578)
+                                                                          for v in x[1:4]] + x[4:]
+                                                                for x in r])))
+    m.append(("imu_units", "accel_axes_swapped",
+              imu(lambda h, r: [x[:4] + [x[6], x[5], x[4]] for x in r])))
+    # imu_format
+    m.append(("imu_format", "garbage_line", imu(lambda h, r: r[:9] + [["abc", "def"]] + r[9:])))
+    m.append(("imu_format", "missing_column", imu(lambda h, r: r[:9] + [r[9][:5]] + r[10:])))
+    m.append(("imu_format", "header_only", imu(lambda h, r: [])))
+    m.append(("imu_format", "missing_file", lambda d: os.remove(os.path.join(d, "imu.csv"))))
+
+    # scan_index
+    def scans_csv(fn):
+        return lambda d: map_csv(os.path.join(d, "scans.csv"), fn)
+
+    m.append(("scan_index", "duplicate_line", scans_csv(lambda h, r: r[:5] + [r[5]] + r[5:])))
+    m.append(("scan_index", "swapped_lines", scans_csv(lambda h, r: r[:5] + [r[6], r[5]] + r[7:])))
+    m.append(("scan_index", "start_after_end",
+              scans_csv(lambda h, r: [x if i != 7 else [x[0], x[2], x[1]] + x[3:]
+                                      for i, x in enumerate(r)])))
+    m.append(("scan_index", "overlap",
+              scans_csv(lambda h, r: [x if i != 7 else x[:2] + [str(int(x[2]) + 50_000_000)] +
+                                      x[3:] for i, x in enumerate(r)])))
+    m.append(("scan_index", "lidar_gap_1s", scans_csv(lambda h, r: r[:12] + r[22:])))
+    m.append(("scan_index", "wrong_point_count",
+              scans_csv(lambda h, r: [x if i != 4 else x[:3] + ["17"] + x[4:]
+                                      for i, x in enumerate(r)])))
+    m.append(("scan_index", "missing_bin", lambda d: os.remove(scan_files(d)[9])))
+
+    # scan_points
+    def pts(fn, which=None):
+        def go(d):
+            files = scan_files(d)
+            for f in (files if which is None else [files[i] for i in which]):
+                map_points(f, fn)
+        return go
+
+    nan = float("nan")
+    m.append(("scan_points", "truncated_bin", lambda d: open(scan_files(d)[6], "r+b").truncate(
+        16 * 1000 + 7)))
+    m.append(("scan_points", "empty_bin", lambda d: open(scan_files(d)[6], "wb").close()))
+    m.append(("scan_points", "some_nan", pts(lambda p: [q if i % 7 else [nan] + q[1:]
+                                                          for i, q in enumerate(p)])))
+    m.append(("scan_points", "all_nan_one_scan", pts(lambda p: [[nan, nan, nan, q[3]] for q in p],
+                                                    [10])))
+    m.append(("scan_points", "all_at_origin", pts(lambda p: [[0, 0, 0, q[3]] for q in p])))
+    m.append(("scan_points", "all_far", pts(lambda p: [[1e9, 1e9, 1e9, q[3]] for q in p])))
+    m.append(("scan_points", "times_zero", pts(lambda p: [q[:3] + [0] for q in p])))
+    m.append(("scan_points", "times_microseconds", pts(lambda p: [q[:3] + [q[3] // 1000]
+                                                                   for q in p])))
+    m.append(("scan_points", "times_reversed", pts(lambda p: [q[:3] + [99_000_000 - q[3]]
+                                                               for q in p])))
+    m.append(("scan_points", "one_point_far_in_time",
+              pts(lambda p: p[:-1] + [p[-1][:3] + [4_000_000_000]], [8])))
+    for k in range(3):
+        def flip(d, k=k):
+            f = scan_files(d)[rng.randrange(2, 30)]
+            b = bytearray(open(f, "rb").read())
+            for _ in range(rng.randrange(1, 50)):
+                b[rng.randrange(len(b))] = rng.randrange(256)
+            open(f, "wb").write(bytes(b))
+        m.append(("scan_points", f"byte_flips_{k}", flip))
+
+    # extrinsic (ctlio_sim.yaml imu_from_lidar)
+    tr = r"translation: \[0, 0, 0\]"
+    qt = r"quaternion_xyzw: \[0, 0, 0, 1\]"
+    m.append(("extrinsic", "nan_translation", lambda d: edit_yaml(d, tr, "translation: [.nan, 0, 0]")))
+    m.append(("extrinsic", "inf_translation", lambda d: edit_yaml(d, tr, "translation: [.inf, 0, 0]")))
+    m.append(("extrinsic", "nan_quaternion", lambda d: edit_yaml(d, qt, "quaternion_xyzw: [.nan, 0, 0, 1]")))
+    m.append(("extrinsic", "zero_quaternion", lambda d: edit_yaml(d, qt, "quaternion_xyzw: [0, 0, 0, 0]")))
+    m.append(("extrinsic", "unnormalised_quaternion",
+              lambda d: edit_yaml(d, qt, "quaternion_xyzw: [0, 0, 0, 2]")))
+    m.append(("extrinsic", "wrong_by_10cm", lambda d: edit_yaml(d, tr, "translation: [0.1, 0, 0]")))
+    m.append(("extrinsic", "wrong_by_5deg",
+              lambda d: edit_yaml(d, qt, "quaternion_xyzw: [0, 0, 0.0436194, 0.9990482]")))
+
+    # ground_truth
+    def gt(fn):
+        return lambda d: map_csv(os.path.join(d, "ground_truth.csv"), fn)
+    m.append(("ground_truth", "nan_row", gt(lambda h, r: r[:50] + [[r[50][0], "nan"] + r[50][2:]] +
+                                            r[51:])))
+    m.append(("ground_truth", "swapped_rows", gt(lambda h, r: r[:50] + [r[51], r[50]] + r[52:])))
+    m.append(("ground_truth", "zero_quaternion",
+              gt(lambda h, r: r[:50] + [r[50][:4] + ["0", "0", "0", "0"]] + r[51:])))
+    m.append(("ground_truth", "truncated", gt(lambda h, r: r[:len(r) // 3] + [r[len(r) // 3][:3]])))
+
+    # dataset yaml
+    m.append(("dataset_yaml", "gravity_nan", lambda d: edit_yaml(d, r"gravity: [0-9.]+", "gravity: .nan")))
+    m.append(("dataset_yaml", "gravity_zero", lambda d: edit_yaml(d, r"gravity: [0-9.]+", "gravity: 0")))
+    m.append(("dataset_yaml", "garbage", lambda d: open(os.path.join(d, "ctlio_sim.yaml"), "w").write(
+        "format: ctlio_sim\nversion: 2\nimu_from_lidar: [[[\n")))
+    m.append(("dataset_yaml", "wrong_version",
+              lambda d: edit_yaml(d, r"version: 2", "version: 99")))
+    return m
+
+
+def config_mutations(base_config):
+    """(class, name, config text) — keys of data/sim_lio.yaml given bad values."""
+    text = open(base_config).read()
+    keys = re.findall(r"^\s+([a-z_]+):\s*([-0-9.e]+)\s*(?:#.*)?$", text, re.M)
+    out = []
+    for key, _ in keys[:40]:
+        for bad in (".nan", "-1", "1e30"):
+            new = re.sub(rf"^(\s+{key}:)\s*[-0-9.e]+", rf"\1 {bad}", text, count=1, flags=re.M)
+            out.append(("config", f"{key}={bad}", new))
+    return out
+
+
+FLAG_MUTATIONS = [
+    ("flags", "max_scans=-1", ["--max_scans=-1"]),
+    ("flags", "play_rate=-1", ["--play_rate=-1"]),
+    ("flags", "play_rate=nan", ["--play_rate=nan"]),
+    ("flags", "frontend_threads=100000", ["--frontend_threads=100000"]),
+    ("flags", "frontend_threads=0", ["--frontend_threads=0"]),
+    ("flags", "map_voxel_size=0", ["--save_map", "--map_voxel_size=0"]),
+    ("flags", "method=unknown", ["--method=foo"]),
+    ("flags", "imu_accel_scale=nan", ["--imu_accel_scale=nan"]),
+    ("flags", "max_imu_gap_error=-1", ["--max_imu_gap_error=-1"]),
+]
+
+
+def bag_mutations(rng, size):
+    out = []
+    for k in range(8):
+        cut = rng.randrange(13, size)
+        out.append(("bag", f"truncated_at_{cut}", ("truncate", cut)))
+    for k in range(12):
+        n = rng.choice((1, 4, 64))
+        out.append(("bag", f"byte_flips_{n}_{k}",
+                    ("flip", [(rng.randrange(size), rng.randrange(256)) for _ in range(n)])))
+    return out
+
+
+# ---------------------------------------------------------------- running and judging
+def run(cmd, timeout, log_path):
+    """(exit code or None on timeout, log text, peak resident MB of the child, seconds)."""
+    t0 = time.time()
+    with open(log_path, "w") as log:
+        p = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, preexec_fn=os.setsid)
+        while True:
+            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.time() - t0 > timeout:
+                os.killpg(p.pid, signal.SIGKILL)
+                os.wait4(p.pid, 0)
+                return None, open(log_path, errors="replace").read(), 0, time.time() - t0
+            time.sleep(0.05)
+    p.returncode = -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
+    return (p.returncode, open(log_path, errors="replace").read(), usage.ru_maxrss / 1024.0,
+            time.time() - t0)
+
+
+def evaluation(out_dir):
+    ev = {}
+    for root, _, files in os.walk(out_dir):
+        if "evaluation.txt" in files:
+            for line in read_lines(os.path.join(root, "evaluation.txt")):
+                k, _, v = line.partition(" ")
+                ev[k] = v
+    return ev
+
+
+def trajectory_has_nan(out_dir):
+    for root, _, files in os.walk(out_dir):
+        for f in files:
+            if f.startswith("trajectory") and f.endswith(".tum"):
+                with open(os.path.join(root, f)) as fh:
+                    for line in fh:
+                        if re.search(r"nan|inf", line, re.I):
+                            return True
+    return False
+
+
+def judge(rc, log, peak_mb, out_dir, names, clean_ate):
+    if rc is None:
+        return "hang", ""
+    last = [l for l in log.splitlines() if l.strip()]
+    msg = last[-1][:200] if last else ""
+    if peak_mb > 1024:
+        return "memory", msg
+    if rc < 0:
+        return "crash", msg
+    if rc != 0 and evaluation(out_dir):
+        return "run_failed", msg
+    if rc != 0:
+        text = log[-2000:]
+        named = any(n in text for n in names)
+        return ("error" if named else "error_unnamed"), msg
+    ev = evaluation(out_dir)
+    ate = ev.get("ate_rmse_m")
+    if trajectory_has_nan(out_dir) or (ate is not None and not math.isfinite(float(ate))):
+        return "nan_exit0", msg
+    warned = any(float(ev.get(k, "0") or 0) > 0 for k in WARN_COUNTERS) or any(
+        k in ev for k in WARN_KEYS)
+    if warned:
+        return "warned", ev.get("first_input_warning", msg)[:200]
+    if ate is not None and float(ate) > 3 * clean_ate:
+        return "silent_wrong", f"ATE {float(ate):.4f} m vs clean {clean_ate:.4f} m"
+    return "accurate", ""
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--build", default="build-test")
+    ap.add_argument("--out", default="/tmp/ctlio_probe")
+    ap.add_argument("--seed", type=int, default=7)
+    ap.add_argument("--only", default="", help="run only classes containing this text")
+    ap.add_argument("--timeout", type=float, default=180)
+    ap.add_argument("--config", default=os.path.join(os.path.dirname(__file__), "..", "data",
+                                                      "sim_lio.yaml"))
+    a = ap.parse_args()
+    rng = random.Random(a.seed)
+    sim = os.path.join(a.build, "apps", "ctlio_simulate")
+    odo = os.path.join(a.build, "apps", "lio", "ctlio_odometry")
+    os.makedirs(a.out, exist_ok=True)
+    clean = os.path.join(a.out, "clean")
+    bag = os.path.join(a.out, "clean.bag")
+    sim_args = ["--regime=medium", f"--index={200 + a.seed % 50}", "--duration=4", "--beams=32"]
+    if not os.path.isdir(clean):
+        subprocess.run([sim, *sim_args, f"--output={clean}"], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    if not os.path.exists(bag):
+        subprocess.run([sim, *sim_args, "--layout=rosbag", f"--output={bag}"], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    base = [odo, f"--config={a.config}", "--plot=false"]
+    rc, log, _, _ = run(base + [f"--dataset={clean}", f"--out={a.out}/clean_run"], a.timeout,
+                        os.path.join(a.out, "clean.log"))
+    clean_ate = float(evaluation(f"{a.out}/clean_run")["ate_rmse_m"])
+    print(f"clean run: ATE {clean_ate:.4f} m", flush=True)
+
+    cases = []
+    for cls, name, fn in folder_mutations(rng):
+        cases.append((cls, name, "folder", fn))
+    for cls, name, text in config_mutations(a.config):
+        cases.append((cls, name, "config", text))
+    for cls, name, flags in FLAG_MUTATIONS:
+        cases.append((cls, name, "flags", flags))
+    for cls, name, op in bag_mutations(rng, os.path.getsize(bag)):
+        cases.append((cls, name, "bag", op))
+    cases = [c for c in cases if a.only in c[0]]
+
+    rows = []
+    for i, (cls, name, kind, what) in enumerate(cases):
+        work = os.path.join(a.out, "work")
+        shutil.rmtree(work, ignore_errors=True)
+        os.makedirs(work)
+        out_dir = os.path.join(work, "run")
+        args = list(base)
+        names = []
+        if kind == "folder":
+            d = os.path.join(work, "seq")
+            shutil.copytree(clean, d)
+            what(d)
+            args.append(f"--dataset={d}")
+            names = [d, "imu.csv", "scans.csv", ".bin", "ctlio_sim.yaml", "ground_truth"]
+        elif kind == "config":
+            cfg = os.path.join(work, "cfg.yaml")
+            open(cfg, "w").write(what)
+            args = [odo, f"--config={cfg}", "--plot=false", f"--dataset={clean}"]
+            names = ["cfg.yaml", name.split("=")[0]]
+        elif kind == "flags":
+            args += [f"--dataset={clean}", *what]
+            names = [f.split("=")[0].lstrip("-") for f in what]
+        else:
+            b = os.path.join(work, "m.bag")
+            data = bytearray(open(bag, "rb").read())
+            if what[0] == "truncate":
+                data = data[:what[1]]
+            else:
+                for pos, val in what[1]:
+                    data[pos] = val
+            open(b, "wb").write(bytes(data))
+            args.append(f"--dataset={b}")
+            names = ["m.bag"]
+        args.append(f"--out={out_dir}")
+        rc, log, peak, secs = run(args, a.timeout, os.path.join(work, "log.txt"))
+        outcome, msg = judge(rc, log, peak, out_dir, names, clean_ate)
+        rows.append(dict(cls=cls, name=name, outcome=outcome, rc=rc, seconds=f"{secs:.1f}",
+                         message=msg.replace("\n", " ")))
+        flag = "  <-- FINDING" if outcome in FINDINGS else ""
+        print(f"[{i + 1}/{len(cases)}] {cls:13s} {name:32s} {outcome}{flag}", flush=True)
+
+    with open(os.path.join(a.out, "probe.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    counts = {}
+    for r in rows:
+        counts.setdefault(r["cls"], {}).setdefault(r["outcome"], 0)
+        counts[r["cls"]][r["outcome"]] += 1
+    print("\nclass          cases  outcomes")
+    for cls, c in counts.items():
+        print(f"{cls:13s} {sum(c.values()):6d}  " +
+              ", ".join(f"{k} {v}" for k, v in sorted(c.items())))
+    findings = sum(1 for r in rows if r["outcome"] in FINDINGS)
+    print(f"\n{len(rows)} mutants, {findings} findings; {a.out}/probe.csv")
+    return 1 if findings else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
