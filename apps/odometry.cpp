@@ -355,9 +355,9 @@ int main(int argc, char** argv) {
       }
       config.Validate();
       // Before the readers read anything; --strict given explicitly wins over input.strict.
-      ctlio::io::WarningLimiter::SetStrict(
-          gflags::GetCommandLineFlagInfoOrDie("strict").is_default ? config.input.strict
-                                                                   : FLAGS_strict);
+      ctlio::io::WarningLimiter::SetStrict(gflags::GetCommandLineFlagInfoOrDie("strict").is_default
+                                               ? config.input.strict
+                                               : FLAGS_strict);
       auto source = OpenSource(config.input.max_imu_gap_error);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
