@@ -308,6 +308,8 @@ int main(int argc, char** argv) {
     RequireInRange("trajectory_rate", FLAGS_trajectory_rate, 0.0, 1e4, " Hz (0 = off)");
     RequireInRange("play_rate", FLAGS_play_rate, 0.0, 1e6, " (0 = back to back)");
     RequireInRange("max_imu_gap_error", FLAGS_max_imu_gap_error, 0.0, 1e6, " s (0 = off)");
+    RequireInRange("imu_accel_scale", FLAGS_imu_accel_scale, 1e-6, 1e6,
+                   " (9.80665 for an IMU reporting g)");
     RequireInRange("sim_index", FLAGS_sim_index, 0, 1'000'000);
     RequireInRange("sim_duration", FLAGS_sim_duration, 0.1, 3600.0, " s");
     RequireInRange("sim_beams", FLAGS_sim_beams, 1, 4096);
@@ -350,7 +352,16 @@ int main(int argc, char** argv) {
       if (!FLAGS_time_offset.empty()) {
         config.calibration.time_offset_s.clear();
         for (const std::string& d : SplitList(FLAGS_time_offset)) {
-          config.calibration.time_offset_s.push_back(std::stod(d));
+          size_t used = 0;
+          double v = NAN;
+          try {
+            v = std::stod(d, &used);
+          } catch (const std::exception&) {
+          }
+          if (used != d.size() || !std::isfinite(v)) {
+            throw std::runtime_error("--time_offset: '" + d + "' is not a number of seconds");
+          }
+          config.calibration.time_offset_s.push_back(v);
         }
       }
       config.Validate();
