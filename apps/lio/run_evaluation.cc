@@ -81,6 +81,7 @@ void WriteRunEvaluation(const RunSummary& run,
   }
   // The reader's recoveries: a run that exits 0 after them says what was recovered from.
   if (!run.input_defects.empty()) ev << "input_defect_kinds " << run.input_defects.size() << "\n";
+  for (const std::string& w : run.config_warnings) ev << "config_warning \"" << w << "\"\n";
   for (const io::InputDefect& d : run.input_defects) {
     ev << "input_defect \"" << d.kind << "\" " << d.count << " \"" << d.first << "\"\n";
   }
@@ -222,6 +223,9 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),
                   r.extrinsic_disagreement.c_str());
+    }
+    for (const std::string& w : r.config_warnings) {
+      std::printf("  %-10s WARNING config: %s\n", r.method.c_str(), w.c_str());
     }
     for (const io::InputDefect& d : r.input_defects) {
       std::printf("  %-10s WARNING input: %zu x %s (first: %s)\n", r.method.c_str(), d.count,

@@ -21,6 +21,7 @@
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/warning_limiter.h"
 #include "ctlio/solvers/lio/calibrating_odometry.h"
+#include "ctlio/solvers/lio/config_plausibility.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "extrinsic_agreement.h"
 #include "run_checks.h"
@@ -246,6 +247,8 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   bool have_previous = false;
   int64_t previous_end = 0;
   run.method = lio::LioMethodName(config.method);
+  run.config_warnings = lio::ImplausibleSettings(config);
+  for (const std::string& w : run.config_warnings) LOG(WARNING) << run.method << ": config: " << w;
   run.source = source.Name();
   const SE3 T_imu_lidar = config.T_imu_lidar;
   run.initial_extrinsic = run.final_extrinsic = T_imu_lidar;

@@ -89,6 +89,8 @@ struct RunSummary {
   // The reader's recoveries (DataSource::InputDefects: duplicate IMU times, IMU gaps, points
   // outside their sweep, re-timed sweeps, unusable scans), one entry per kind.
   std::vector<io::InputDefect> input_defects;
+  // Settings that are legal but beyond any real sensor (lio/config_plausibility.h).
+  std::vector<std::string> config_warnings;
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  // wall time per scan (first excluded)
   double median_cpu_ms = 0.0, p95_cpu_ms = 0.0;        // thread CPU time per scan
   // Medians over the scans of the wall-time split (ScanResult::ms_*).
