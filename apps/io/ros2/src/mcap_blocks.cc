@@ -1,6 +1,8 @@
 // MCAP reader: the records of a block (a chunk, decompressed; or a run of records outside
 // chunks), the pass over the data section of a file without a usable summary, and the loading of
 // a block's messages into the merge (mcap_reader.h).
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -79,11 +81,19 @@ void McapReader::ScanDataSection() {
   };
   std::vector<uint8_t> storage;
   for (uint64_t off = data_start_; off < data_end_;) {
-    if (data_end_ - off < mcap::kRecordPrefix) Fail(off, "truncated record");
-    const std::vector<uint8_t> prefix = ReadAt(off, mcap::kRecordPrefix);
+    const bool whole = data_end_ - off >= mcap::kRecordPrefix;
+    const std::vector<uint8_t> prefix = ReadAt(off, whole ? mcap::kRecordPrefix : 0);
     ByteCursor p(prefix.data(), prefix.size(), path_, off);
-    const uint8_t op = p.U8("opcode");
-    const uint64_t length = p.U64("record length");
+    const uint8_t op = whole ? p.U8("opcode") : 0;
+    const uint64_t length = whole ? p.U64("record length") : 0;
+    if (truncated_ && (!whole || length > data_end_ - off - mcap::kRecordPrefix)) {
+      LOG(WARNING) << path_ << ": does not end with the MCAP magic (recording interrupted?): "
+                   << "read up to its last complete record, " << data_end_ - off
+                   << " bytes before its end";
+      data_end_ = off;
+      break;
+    }
+    if (!whole) Fail(off, "truncated record");
     if (length > data_end_ - off - mcap::kRecordPrefix) {
       Fail(off, "record (opcode " + std::to_string(op) + ") of " + std::to_string(length) +
                     " bytes where " + std::to_string(data_end_ - off - mcap::kRecordPrefix) +

@@ -2,6 +2,8 @@
 // (mcap_reader.h). Decoding the records of a block is in mcap_blocks.cc.
 #include "mcap_reader.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -34,42 +36,45 @@ McapReader::McapReader(const std::string& path) : path_(path) {
     throw std::runtime_error(path + ": not an MCAP file (no MCAP magic at its start)");
   }
   if (file_size_ < min_size) Fail(file_size_, "file of " + std::to_string(file_size_) + " bytes");
-  if (std::memcmp(ReadAt(file_size_ - 8, 8).data(), mcap::kMagic, 8) != 0) {
-    throw std::runtime_error(path +
-                             ": does not end with the MCAP magic: truncated, or still being "
-                             "recorded (`mcap recover` can rebuild its end)");
-  }
-  const uint64_t footer = file_size_ - 8 - mcap::kFooterRecord;
+  // A file cut short (the recorder stopped before writing its summary and footer): its complete
+  // records are read, with a warning.
+  const bool complete = std::memcmp(ReadAt(file_size_ - 8, 8).data(), mcap::kMagic, 8) == 0;
+  const uint64_t footer = complete ? file_size_ - 8 - mcap::kFooterRecord : file_size_;
   std::vector<uint8_t> storage;
   uint8_t op = 0;
   ByteCursor header = RecordAt(8, footer, &storage, &op);
-  if (op != mcap::kHeader)
+  if (op != mcap::kHeader) {
     Fail(8, "first record is not a Header (opcode " + std::to_string(op) + ")");
+  }
   header.String("profile");
   header.String("library");
   data_start_ = 8 + mcap::kRecordPrefix + (storage.size());
-  ByteCursor f = RecordAt(footer, file_size_ - 8, &storage, &op);
-  if (op != mcap::kFooter || storage.size() != mcap::kFooterContent) {
-    Fail(footer, "no Footer record before the end magic");
-  }
-  const uint64_t summary_start = f.U64("summary_start");
-  const uint64_t summary_offset_start = f.U64("summary_offset_start");
   data_end_ = footer;
-  if (summary_start != 0) {
-    if (summary_start < data_start_ || summary_start > footer) {
-      Fail(footer,
-           "summary_start " + std::to_string(summary_start) + " outside the file's records");
+  if (!complete) {
+    truncated_ = true;
+  } else {
+    ByteCursor f = RecordAt(footer, file_size_ - 8, &storage, &op);
+    if (op != mcap::kFooter || storage.size() != mcap::kFooterContent) {
+      Fail(footer, "no Footer record before the end magic");
     }
-    uint64_t summary_end = footer;
-    if (summary_offset_start != 0) {
-      if (summary_offset_start < summary_start || summary_offset_start > footer) {
-        Fail(footer, "summary_offset_start " + std::to_string(summary_offset_start) +
-                         " outside the summary");
+    const uint64_t summary_start = f.U64("summary_start");
+    const uint64_t summary_offset_start = f.U64("summary_offset_start");
+    if (summary_start != 0) {
+      if (summary_start < data_start_ || summary_start > footer) {
+        Fail(footer,
+             "summary_start " + std::to_string(summary_start) + " outside the file's records");
       }
-      summary_end = summary_offset_start;
+      uint64_t summary_end = footer;
+      if (summary_offset_start != 0) {
+        if (summary_offset_start < summary_start || summary_offset_start > footer) {
+          Fail(footer, "summary_offset_start " + std::to_string(summary_offset_start) +
+                           " outside the summary");
+        }
+        summary_end = summary_offset_start;
+      }
+      data_end_ = summary_start;
+      ReadSummary(summary_start, summary_end);
     }
-    data_end_ = summary_start;
-    ReadSummary(summary_start, summary_end);
   }
   if (blocks_.empty() || channels_.empty()) {
     // No summary, or one without chunk indexes and channels: one pass over the data section.

@@ -9,6 +9,8 @@
 // The blocks come from the summary's chunk indexes when the file has them (with the channels and
 // the statistics' message counts); otherwise from one pass over the data section at open, which
 // decompresses each chunk once (one at a time) to find its channels, message counts and times.
+// A file without its end magic (recording interrupted) is read up to its last complete record,
+// with a warning.
 #pragma once
 
 #include <cstdio>
@@ -91,6 +93,7 @@ class McapReader : public StorageReader {
   std::unique_ptr<std::FILE, Close> file_;
   uint64_t file_size_ = 0;
   uint64_t data_start_ = 0, data_end_ = 0;
+  bool truncated_ = false;  // no end magic: the data section ends at its last complete record
   struct Channel {
     uint16_t schema_id = 0;
     std::string topic, encoding;
