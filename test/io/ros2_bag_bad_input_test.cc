@@ -105,6 +105,18 @@ TEST_F(Ros2BagTest, CorruptChunkDataFailsItsCrc) {
   EXPECT_NE(ReadError(bad).find("CRC"), std::string::npos) << ReadError(bad);
 }
 
+TEST_F(Ros2BagTest, CorruptSummaryFailsItsCrc) {
+  const std::string good = Bytes(WriteMcap("good.mcap", McapWriteOptions(), Messages(10, 5)));
+  uint64_t summary_start = 0;
+  std::memcpy(&summary_start, good.data() + good.size() - 8 - 20, 8);
+  ASSERT_GT(summary_start, 0u);
+  std::string bytes = good;
+  bytes[summary_start + 20] ^= 0x01;  // inside the first schema's name
+  const std::string bad = (dir_ / "bad.mcap").string();
+  Put(bad, bytes);
+  EXPECT_NE(ReadError(bad).find("summary CRC mismatch"), std::string::npos) << ReadError(bad);
+}
+
 TEST_F(Ros2BagTest, OversizedChunkIsRefusedBeforeDecompressing) {
   McapWriteOptions o;
   o.compression = "lz4";

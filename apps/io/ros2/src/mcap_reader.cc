@@ -8,6 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "compression.h"
 #include "mcap_format.h"
 
 namespace ctlio::io::ros2 {
@@ -59,6 +60,7 @@ McapReader::McapReader(const std::string& path) : path_(path) {
     }
     const uint64_t summary_start = f.U64("summary_start");
     const uint64_t summary_offset_start = f.U64("summary_offset_start");
+    const uint32_t summary_crc = f.U32("summary_crc");
     if (summary_start != 0) {
       if (summary_start < data_start_ || summary_start > footer) {
         Fail(footer,
@@ -73,6 +75,7 @@ McapReader::McapReader(const std::string& path) : path_(path) {
         summary_end = summary_offset_start;
       }
       data_end_ = summary_start;
+      if (summary_crc != 0) CheckSummaryCrc(summary_start, footer, summary_crc);
       ReadSummary(summary_start, summary_end);
     }
   }
@@ -148,6 +151,22 @@ void McapReader::AddChannel(ByteCursor c) {
            ch.topic + "'");
   }
   channels_[id] = ch;
+}
+
+void McapReader::CheckSummaryCrc(uint64_t summary_start, uint64_t footer, uint32_t expected) const {
+  // The summary and summary offset sections, then the footer up to summary_offset_start; read in
+  // pieces (a corrupt summary_start may point far back).
+  uint32_t crc = 0;
+  for (uint64_t off = summary_start; off < footer;) {
+    const uint64_t n = std::min<uint64_t>(footer - off, 1 << 20);
+    const std::vector<uint8_t> piece = ReadAt(off, n);
+    crc = Crc32(piece.data(), piece.size(), crc);
+    off += n;
+  }
+  const std::vector<uint8_t> prefix = ReadAt(footer, mcap::kRecordPrefix + 16);
+  if (Crc32(prefix.data(), prefix.size(), crc) != expected) {
+    Fail(summary_start, "summary CRC mismatch (summary from here to the footer corrupted)");
+  }
 }
 
 void McapReader::ReadSummary(uint64_t start, uint64_t end) {

@@ -71,6 +71,7 @@ class McapReader : public StorageReader {
   ByteCursor RecordAt(uint64_t offset, uint64_t end, std::vector<uint8_t>* storage,
                       uint8_t* opcode) const;
   void ReadSummary(uint64_t summary_start, uint64_t summary_end);
+  void CheckSummaryCrc(uint64_t summary_start, uint64_t footer, uint32_t expected) const;
   void ScanDataSection();
   void AddSchema(ByteCursor c);
   void AddChannel(ByteCursor c);

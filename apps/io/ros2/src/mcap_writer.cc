@@ -2,8 +2,8 @@
 // message type (encoding "ros2msg", name the type; the definition is left empty, the type name is
 // what readers use), a channel per topic (message encoding "cdr"), messages in chunks of about
 // 1 MiB each followed by its message indexes, and a summary (schemas, channels, statistics, chunk
-// indexes and the summary offsets). Only the current chunk is held in memory; the summary keeps
-// one chunk index per chunk (about 100 bytes per MiB of bag).
+// indexes and the summary offsets, with the summary's CRC). Only the current chunk is held in
+// memory; the summary keeps one chunk index per chunk (about 100 bytes per MiB of bag).
 #include <algorithm>
 #include <cstdio>
 #include <map>
@@ -90,6 +90,8 @@ class McapWriter : public StorageWriter {
     uint64_t summary_start = 0, summary_offset_start = 0;
     if (options_.summary) {
       summary_start = offset_;
+      summary_crc_ = 0;
+      in_summary_ = true;
       std::vector<std::vector<uint8_t>> offsets;
       auto group = [&](uint8_t op, const std::vector<std::vector<uint8_t>>& records) {
         if (records.empty()) return;
@@ -108,11 +110,18 @@ class McapWriter : public StorageWriter {
       summary_offset_start = offset_;
       for (const auto& o : offsets) PutRecord(mcap::kSummaryOffset, o);
     }
+    // The summary's CRC covers the summary section, the summary offset section and the footer
+    // up to summary_offset_start (spec, "Footer"); 0 (not computed) without a summary.
     ByteWriter footer;
+    footer.U8(mcap::kFooter);
+    footer.U64(mcap::kFooterContent);
     footer.U64(summary_start);
     footer.U64(summary_offset_start);
-    footer.U32(0);  // the summary's CRC: not computed
-    PutRecord(mcap::kFooter, footer.bytes());
+    const uint32_t crc =
+        Crc32(footer.bytes().data(), footer.bytes().size(), options_.summary ? summary_crc_ : 0);
+    footer.U32(options_.summary ? crc : 0);
+    in_summary_ = false;
+    Put(footer.bytes().data(), footer.bytes().size());
     Put(mcap::kMagic, 8);
     const bool ok = std::fflush(file_) == 0 && std::ferror(file_) == 0;
     std::fclose(file_);
@@ -124,6 +133,7 @@ class McapWriter : public StorageWriter {
   void Put(const uint8_t* p, size_t n) {
     if (std::fwrite(p, 1, n, file_) != n) throw std::runtime_error(path_ + ": write error");
     offset_ += n;
+    if (in_summary_) summary_crc_ = Crc32(p, n, summary_crc_);
   }
   void PutRecord(uint8_t op, const std::vector<uint8_t>& content) {
     ByteWriter prefix;
@@ -213,6 +223,8 @@ class McapWriter : public StorageWriter {
   McapWriteOptions options_;
   std::FILE* file_ = nullptr;
   uint64_t offset_ = 0;
+  bool in_summary_ = false;
+  uint32_t summary_crc_ = 0;
   std::map<std::string, uint16_t> schema_ids_;
   std::vector<std::vector<uint8_t>> schemas_, channels_, chunk_indexes_;
   std::vector<uint32_t> sequence_;
