@@ -269,7 +269,8 @@ bool McapReader::Next(Ros2Message* message) {
   message->data = std::move(top.data);
   ++returned_;
   where_ = path_ + ": message " + std::to_string(returned_) + " (" +
-           (top.chunk ? "chunk" : "record") + " at byte " + std::to_string(top.block_offset) + ")";
+           (top.chunk ? "chunk at byte " : "records from byte ") +
+           std::to_string(top.block_offset) + ")";
   pending_.pop();
   return true;
 }
