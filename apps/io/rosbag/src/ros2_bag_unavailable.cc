@@ -1,8 +1,9 @@
-// Built instead of ros2_bag_reader_stream.cc when the ROS 2 containers (ctlio::io_ros2) are not
-// part of the build: ROS 2 bags are then not recognised, and opening one says why.
+// Built instead of ros2_bag_containers.cc when the ROS 2 containers (ctlio::io_ros2) are not
+// part of the build: ROS 2 bags are then not recognised, and reading or writing one says why.
 #include <stdexcept>
 
 #include "ctlio/io/bag_stream.h"
+#include "ctlio/io/bag_writer.h"
 
 namespace ctlio::io {
 
@@ -11,5 +12,12 @@ std::unique_ptr<BagStream> OpenRos2BagStream(const std::string& path) {
 }
 
 bool IsRos2BagPath(const std::string&) { return false; }
+
+std::unique_ptr<Ros2ContainerWriter> OpenRos2ContainerWriter(const std::string& path,
+                                                             ros2::Ros2Storage,
+                                                             ros2::Ros2Compression) {
+  throw std::runtime_error(path +
+                           ": ROS 2 bags cannot be written by this build (no ctlio::io_ros2)");
+}
 
 }  // namespace ctlio::io
