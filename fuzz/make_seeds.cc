@@ -5,8 +5,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
+#include "ctlio/io/bag_writer.h"
+#include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/io/rosbag_source.h"
@@ -107,6 +110,41 @@ int main(int argc, char** argv) {
       o.compression = compression;
       io::WriteRosbag(bag_source, (work / "s.bag").string(), o);
       Seed(corpus, "rosbag", compression, Read(work / "s.bag"));
+    }
+    {
+      // fuzz_cdr_messages: the first message of each type as WriteRos2Bag encodes it, after the
+      // byte that picks the type (fuzz_cdr_messages.cc); PoseStamped from the first pose.
+      struct FirstOfEach : io::Ros2ContainerWriter {
+        std::vector<std::string> types;
+        std::map<std::string, std::string> first;
+        size_t AddTopic(const std::string&, const std::string& type) override {
+          types.push_back(type);
+          return types.size() - 1;
+        }
+        void Write(size_t topic, int64_t, const std::vector<uint8_t>& data) override {
+          first.emplace(types[topic], std::string(data.begin(), data.end()));
+        }
+        void Close() override {}
+      } messages;
+      sim::SimulatedSource bag_source(Tiny());
+      io::WriteRos2Bag(bag_source, messages);
+      const char* kTypes[] = {"sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Imu",
+                              "tf2_msgs/msg/TFMessage", "nav_msgs/msg/Odometry"};
+      for (char k = 0; k < 4; ++k) {
+        Seed(corpus, "cdr_messages", std::to_string(int(k)), k + messages.first.at(kTypes[int(k)]));
+      }
+      const std::string& odometry = messages.first.at(kTypes[3]);
+      nav_msgs::Odometry o;
+      io::ros2::DecodeCdr(reinterpret_cast<const uint8_t*>(odometry.data()), odometry.size(), "",
+                          &o);
+      geometry_msgs::PoseStamped p;
+      p.header = o.header;
+      p.pose = o.pose.pose;
+      for (const auto e : {io::ros2::CdrEndian::kLittle, io::ros2::CdrEndian::kBig}) {
+        const std::vector<uint8_t> b = io::ros2::EncodeCdr(p, e);
+        Seed(corpus, "cdr_messages", e == io::ros2::CdrEndian::kBig ? "4_be" : "4",
+             char(4) + std::string(b.begin(), b.end()));
+      }
     }
     // The structure-aware target builds its valid message itself; its inputs are edit recipes,
     // and the empty one (no edit) is the valid message.

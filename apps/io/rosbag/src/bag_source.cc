@@ -52,9 +52,7 @@ std::string PickTopic(const std::map<std::string, std::string>& topics, const st
 
 std::unique_ptr<BagStream> OpenStream(const std::string& path, const std::string& format) {
   if (format == "rosbag" || (format.empty() && IsRosbagFile(path))) {
-    if (!std::filesystem::is_regular_file(path)) {
-      throw std::runtime_error(path + ": file not found");
-    }
+    if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": file not found");
     if (!IsRosbagFile(path)) {
       throw std::runtime_error(path + ": not a ROS 1 bag (no '#ROSBAG V2.0' header)");
     }
