@@ -1,5 +1,6 @@
-// The CDR decoders of ROS 2 bag messages (cdr_messages.h) on arbitrary bytes: the first byte picks
-// the type (PointCloud2, Imu, TFMessage, Odometry, PoseStamped: its value mod 5), the rest is the
+// The CDR decoders of ROS 2 bag messages (cdr_messages.h, cdr_livox.h) on arbitrary bytes: the
+// first byte picks the type (PointCloud2, Imu, TFMessage, Odometry, PoseStamped, Livox CustomMsg:
+// its value mod 6), the rest is the
 // serialized message (encapsulation header and body). Seeds: the simulator's messages as
 // WriteRos2Bag encodes them (fuzz_make_seeds). A decoder may throw std::runtime_error; anything
 // else is a finding, and so is a decoded message whose encoding does not decode back to the same
@@ -8,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "ctlio/io/cdr_livox.h"
 #include "ctlio/io/cdr_messages.h"
 #include "fuzz_common.h"
 
@@ -39,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const uint8_t* body = data + 1;
   const size_t n = size - 1;
-  switch (data[0] % 5) {
+  switch (data[0] % 6) {
     case 0:
       RoundTrip<sensor_msgs::PointCloud2>(body, n);
       break;
@@ -52,8 +54,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 3:
       RoundTrip<nav_msgs::Odometry>(body, n);
       break;
-    default:
+    case 4:
       RoundTrip<geometry_msgs::PoseStamped>(body, n);
+      break;
+    default:
+      RoundTrip<LivoxCustomMsg>(body, n);
       break;
   }
   return 0;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "ctlio/io/bag_writer.h"
+#include "ctlio/io/cdr_livox.h"
 #include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_cloud_io.h"
@@ -145,6 +146,22 @@ int main(int argc, char** argv) {
         Seed(corpus, "cdr_messages", e == io::ros2::CdrEndian::kBig ? "4_be" : "4",
              char(4) + std::string(b.begin(), b.end()));
       }
+      // A Livox CustomMsg: the first scan's first 16 points, offsets from the scan start.
+      sim::SimulatedSource livox_source(Tiny());
+      io::ScanFrame f;
+      livox_source.Next(&f);
+      io::ros2::LivoxCustomMsg livox;
+      livox.header.stamp.fromNSec(uint64_t(f.start_ns));
+      livox.header.frame_id = "livox_frame";
+      livox.timebase = uint64_t(f.start_ns);
+      for (size_t i = 0; i < f.cloud.size() && i < 16; ++i) {
+        const Vec3& q = f.cloud.points[i];
+        livox.points.push_back({uint32_t(f.cloud.times_ns[i] - f.start_ns), float(q.x()),
+                                float(q.y()), float(q.z()), 100, 16, uint8_t(i % 4)});
+      }
+      livox.point_num = uint32_t(livox.points.size());
+      const std::vector<uint8_t> lb = io::ros2::EncodeCdr(livox);
+      Seed(corpus, "cdr_messages", "5", char(5) + std::string(lb.begin(), lb.end()));
     }
     // The structure-aware target builds its valid message itself; its inputs are edit recipes,
     // and the empty one (no edit) is the valid message.

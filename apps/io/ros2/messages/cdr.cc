@@ -85,6 +85,18 @@ int32_t CdrReader::I32(const char* what) {
   return v;
 }
 
+uint64_t CdrReader::U64(const char* what) {
+  uint64_t v = 0;
+  Take(8, what, &v);
+  return v;
+}
+
+float CdrReader::F32(const char* what) {
+  float v = 0;
+  Take(4, what, &v);
+  return v;
+}
+
 double CdrReader::F64(const char* what) {
   double v = 0;
   Take(8, what, &v);
@@ -140,6 +152,8 @@ void CdrWriter::Put(const void* v, size_t n) {
 void CdrWriter::U8(uint8_t v) { Put(&v, 1); }
 void CdrWriter::U32(uint32_t v) { Put(&v, 4); }
 void CdrWriter::I32(int32_t v) { Put(&v, 4); }
+void CdrWriter::U64(uint64_t v) { Put(&v, 8); }
+void CdrWriter::F32(float v) { Put(&v, 4); }
 void CdrWriter::F64(double v) { Put(&v, 8); }
 
 void CdrWriter::String(const std::string& s) {

@@ -20,12 +20,6 @@ void ReadTime(CdrReader& in, ros::Time* t) {
   t->nsec = nsec;
 }
 
-void ReadHeader(CdrReader& in, std_msgs::Header* h) {
-  h->seq = 0;
-  ReadTime(in, &h->stamp);
-  h->frame_id = in.String("header.frame_id");
-}
-
 void ReadVector(CdrReader& in, const char* what, double* x, double* y, double* z) {
   *x = in.F64(what);
   *y = in.F64(what);
@@ -58,11 +52,6 @@ void WriteTime(CdrWriter& out, const ros::Time& t) {
   out.U32(t.nsec);
 }
 
-void WriteHeader(CdrWriter& out, const std_msgs::Header& h) {
-  WriteTime(out, h.stamp);
-  out.String(h.frame_id);
-}
-
 void WriteVector(CdrWriter& out, double x, double y, double z) {
   out.F64(x);
   out.F64(y);
@@ -92,6 +81,17 @@ uint32_t Size32(size_t n, const char* what) {
 }
 
 }  // namespace
+
+void ReadHeader(CdrReader& in, std_msgs::Header* h) {
+  h->seq = 0;
+  ReadTime(in, &h->stamp);
+  h->frame_id = in.String("header.frame_id");
+}
+
+void WriteHeader(CdrWriter& out, const std_msgs::Header& h) {
+  WriteTime(out, h.stamp);
+  out.String(h.frame_id);
+}
 
 std::string Ros1TypeName(const std::string& ros2_type) {
   const size_t at = ros2_type.find("/msg/");

@@ -25,6 +25,8 @@ class CdrReader {
   bool Bool(const char* what);  // 0 or 1, anything else is corrupt
   uint32_t U32(const char* what);
   int32_t I32(const char* what);
+  uint64_t U64(const char* what);
+  float F32(const char* what);
   double F64(const char* what);
   std::string String(const char* what);
   // A sequence's element count, each element taking at least `min_element_bytes` on the wire:
@@ -58,6 +60,8 @@ class CdrWriter {
   void Bool(bool v) { U8(v ? 1 : 0); }
   void U32(uint32_t v);
   void I32(int32_t v);
+  void U64(uint64_t v);
+  void F32(float v);
   void F64(double v);
   void String(const std::string& s);
   void Bytes(const std::vector<uint8_t>& bytes);  // the elements of a uint8[] (count written first)

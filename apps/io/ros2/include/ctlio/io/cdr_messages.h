@@ -40,6 +40,10 @@ namespace ctlio::io::ros2 {
 std::string Ros1TypeName(const std::string& ros2_type);
 std::string Ros2TypeName(const std::string& ros1_type);
 
+// std_msgs/msg/Header, for the messages defined elsewhere (cdr_livox.h).
+void ReadHeader(CdrReader& in, std_msgs::Header* header);
+void WriteHeader(CdrWriter& out, const std_msgs::Header& header);
+
 void DecodeCdr(const uint8_t* data, size_t size, const std::string& where,
                sensor_msgs::PointCloud2* msg);
 void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, sensor_msgs::Imu* msg);
