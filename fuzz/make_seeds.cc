@@ -13,11 +13,13 @@
 #include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_cloud_io.h"
+#include "ctlio/io/ros2_bag.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/io/trajectory_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "fuzz_common.h"
+#include "storage.h"  // apps/io/ros2/src: the MCAP writer's options
 
 namespace fs = std::filesystem;
 using namespace ctlio;
@@ -49,6 +51,54 @@ sim::SimConfig Tiny() {
   c.start_ns = 1583836591LL * 1000000000LL + 182590000LL;
   c.imu_from_lidar = io::NewerCollegeImuFromLidar();
   return c;
+}
+
+// ROS 2 bag seeds: the simulated scans' and IMU samples' times on the topics of an Ouster bag,
+// each message its time's bytes (the containers do not look inside messages), in MCAP (three
+// chunk codecs with 2 KiB chunks, no summary, no chunks) and rosbag2's SQLite.
+void SeedRos2(const fs::path& corpus, const fs::path& work, sim::SimulatedSource* source) {
+  std::vector<std::pair<size_t, int64_t>> messages;
+  io::ScanFrame frame;
+  while (source->Next(&frame)) {
+    messages.push_back({0, frame.start_ns});
+    for (const auto& s : frame.imu) messages.push_back({1, s.t_ns});
+  }
+  messages.push_back({2, messages.front().second});
+  const std::vector<std::pair<std::string, std::string>> topics = {
+      {"/os_cloud_node/points", "sensor_msgs/msg/PointCloud2"},
+      {"/os_cloud_node/imu", "sensor_msgs/msg/Imu"},
+      {"/tf_static", "tf2_msgs/msg/TFMessage"}};
+  auto bytes = [](int64_t t, size_t topic) {
+    std::vector<uint8_t> b(topic == 0 ? 400 : 40);
+    for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(t >> (8 * (i % 8)));
+    return b;
+  };
+  struct Variant {
+    const char* name;
+    const char* compression;
+    bool summary, chunked;
+  };
+  for (const Variant& v :
+       {Variant{"none", "", true, true}, Variant{"zstd", "zstd", true, true},
+        Variant{"lz4", "lz4", true, true}, Variant{"no_summary", "", false, true},
+        Variant{"no_chunks", "", true, false}}) {
+    io::ros2::McapWriteOptions o;
+    o.compression = v.compression;
+    o.chunk_bytes = 2048;
+    o.summary = v.summary;
+    o.chunked = v.chunked;
+    const fs::path file = work / (std::string(v.name) + ".mcap");
+    auto w = io::ros2::CreateMcap(file.string(), o);
+    for (size_t i = 0; i < topics.size(); ++i) w->AddTopic(i, topics[i].first, topics[i].second);
+    for (const auto& [topic, t] : messages) w->Write(topic, t, bytes(t, topic));
+    w->Close();
+    Seed(corpus, "mcap", v.name, Read(file));
+  }
+  io::ros2::Ros2BagWriter w((work / "sqlite").string(), io::ros2::Ros2Storage::kSqlite3);
+  for (const auto& [name, type] : topics) w.AddTopic(name, type);
+  for (const auto& [topic, t] : messages) w.Write(topic, t, bytes(t, topic));
+  w.Close();
+  Seed(corpus, "ros2_sqlite", "bag", Read(work / "sqlite/sqlite_0.db3"));
 }
 
 }  // namespace
@@ -163,6 +213,8 @@ int main(int argc, char** argv) {
       const std::vector<uint8_t> lb = io::ros2::EncodeCdr(livox);
       Seed(corpus, "cdr_messages", "5", char(5) + std::string(lb.begin(), lb.end()));
     }
+    sim::SimulatedSource ros2_source(Tiny());
+    SeedRos2(corpus, work, &ros2_source);
     // The structure-aware target builds its valid message itself; its inputs are edit recipes,
     // and the empty one (no edit) is the valid message.
     Seed(corpus, "pointcloud2", "unchanged", "");

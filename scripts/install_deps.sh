@@ -10,6 +10,7 @@ packages=(
   libgflags-dev libgoogle-glog-dev libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev python3-matplotlib python3-numpy
   librosbag-dev libsensor-msgs-dev libtf2-msgs-dev libnav-msgs-dev
+  libzstd-dev liblz4-dev libsqlite3-dev
   clang libclang-rt-14-dev
 )
 

@@ -13,6 +13,7 @@
 #include "ctlio/factors/gp/singer_prior.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/io/dataset.h"
+#include "ctlio/io/ros2_bag.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/manifolds/pose_manifold.h"
 
@@ -164,6 +165,33 @@ void OpenBag(const std::string& folder) {
   }
 }
 
+// ctlio::io_ros2 (and its zstd, lz4 and sqlite3 libraries): a zstd MCAP bag and an SQLite bag
+// written and read back.
+void RoundTripRos2Bags(const std::string& folder) {
+  using namespace ctlio::io::ros2;
+  for (const Ros2Storage storage : {Ros2Storage::kMcap, Ros2Storage::kSqlite3}) {
+    const bool mcap = storage == Ros2Storage::kMcap;
+    const std::string bag = folder + (mcap ? "/ros2_mcap" : "/ros2_sqlite");
+    try {
+      {
+        Ros2BagWriter writer(bag, storage, mcap ? Ros2Compression::kZstd : Ros2Compression::kNone);
+        const size_t imu = writer.AddTopic("/imu", "sensor_msgs/msg/Imu");
+        writer.Write(imu, 2000, {4, 5, 6});
+        writer.Write(imu, 1000, {1, 2, 3});
+      }
+      Ros2BagReader reader(bag);
+      Ros2Message m;
+      const bool first = reader.Next(&m) && m.log_time_ns == 1000 && m.data[0] == 1;
+      const bool second = reader.Next(&m) && m.log_time_ns == 2000 && m.data[2] == 6;
+      Check(first && second && !reader.Next(&m),
+            mcap ? "ROS 2 MCAP bag read back in time order" : "ROS 2 SQLite bag read back", 0.0);
+    } catch (const std::exception& e) {
+      std::printf("consumer: ROS 2 bag %s failed: %s\n", bag.c_str(), e.what());
+      ++failures;
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -174,5 +202,6 @@ int main(int argc, char** argv) {
   FitPose();
   EvaluateFactors();
   OpenBag(argv[1]);
+  RoundTripRos2Bags(argv[1]);
   return failures == 0 ? 0 : 1;
 }
