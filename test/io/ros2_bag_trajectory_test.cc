@@ -10,6 +10,7 @@
 
 #include "common/temp_dir.h"
 #include "ctlio/io/bag_writer.h"
+#include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -144,6 +145,35 @@ TEST(Ros2BagTrajectory, FolderAndRos2BagsGiveTheSameTrajectory) {
       EXPECT_LT(b.ate->rmse, 0.1);
     }
   }
+}
+
+// ctlio_odometry --write_bag on a ROS 2 input: the estimate as nav_msgs/msg/Odometry in a ROS 2
+// bag folder, read back exactly (float64 poses, ns stamps).
+TEST(Ros2BagTrajectory, OdometryBagHoldsTheTrajectory) {
+  const fs::path d = testing::FreshTempDir("ros2_odometry_bag");
+  const auto truth = *sim::SimulatedSource(Sequence()).GroundTruth();
+  WriteOdometryRos2Bag((d / "trajectory_bag").string(), truth);
+  ros2::Ros2BagReader reader((d / "trajectory_bag").string());
+  ASSERT_EQ(reader.topics().size(), 1u);
+  EXPECT_EQ(reader.topics()[0].name, "/ctlio/odometry");
+  EXPECT_EQ(reader.topics()[0].type, "nav_msgs/msg/Odometry");
+  ros2::Ros2Message m;
+  size_t n = 0;
+  while (reader.Next(&m)) {
+    ASSERT_LT(n, truth.size());
+    nav_msgs::Odometry o;
+    ros2::DecodeCdr(m.data.data(), m.data.size(), reader.Where() + ": ", &o);
+    EXPECT_EQ(m.log_time_ns, truth[n].t_ns);
+    EXPECT_EQ(int64_t(o.header.stamp.toNSec()), truth[n].t_ns);
+    EXPECT_EQ(o.header.frame_id, "map");
+    EXPECT_EQ(o.child_frame_id, "os_lidar");
+    const auto& p = o.pose.pose;
+    EXPECT_EQ(Vec3(p.position.x, p.position.y, p.position.z), truth[n].pose.translation());
+    const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
+    EXPECT_LT((q.toRotationMatrix() - truth[n].pose.rotation()).norm(), 1e-14);  // via a quaternion
+    ++n;
+  }
+  EXPECT_EQ(n, truth.size());
 }
 
 }  // namespace
