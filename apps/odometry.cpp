@@ -47,7 +47,6 @@
 
 #include "common/command_line.h"
 #include "common/preset_flags.h"
-#include "ctlio/io/bag_writer.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
@@ -71,9 +70,7 @@
 #include "lio/run_odometry.h"
 #include "lio/run_outputs.h"
 
-DEFINE_string(
-    dataset, "",
-    "Dataset folder, ROS 1 bag file or ROS 2 bag (folder, .mcap, .db3; not with --format sim)");
+DEFINE_string(dataset, "", "Dataset folder, ROS 1 bag or ROS 2 bag (folder, .mcap, .db3)");
 DEFINE_string(
     format, "",
     "newer_college | ctlio | kitti | rosbag | ros2 | sim (default: detect from the folder/file)");
@@ -96,9 +93,9 @@ DEFINE_double(trajectory_rate, 0.0,
               "poses from the final estimates (Singer-LIO: GP interpolation; baseline: IMU "
               "propagation anchored at both states), and trajectory_dense_live.tum, the live "
               "(causal) one; 0 = off");
-DEFINE_bool(write_bag, false,
-            "Also write the estimate as nav_msgs/Odometry into trajectory.bag (a ROS 2 bag folder "
-            "trajectory_bag/ when the input is a ROS 2 bag)");
+DEFINE_bool(
+    write_bag, false,
+    "Also write the estimate as nav_msgs/Odometry: trajectory.bag (ROS 2: trajectory_bag/)");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
 DEFINE_string(config, "",
@@ -241,10 +238,9 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     return std::make_unique<io::BagSource>(FLAGS_dataset, o);
   }
   if (!std::filesystem::is_directory(FLAGS_dataset)) {
-    throw std::runtime_error(FLAGS_dataset +
-                             (std::filesystem::exists(FLAGS_dataset)
-                                  ? ": neither a dataset folder nor a ROS 1 or ROS 2 bag"
-                                  : ": dataset folder or bag does not exist"));
+    throw std::runtime_error(FLAGS_dataset + (std::filesystem::exists(FLAGS_dataset)
+                                                  ? ": neither a dataset folder nor a ROS bag"
+                                                  : ": dataset folder or bag does not exist"));
   }
   if (FLAGS_format.empty()) return io::OpenDataset(FLAGS_dataset, gap_ns);
   if (FLAGS_format == "newer_college") {
@@ -442,12 +438,9 @@ int main(int argc, char** argv) {
       if (config.calibration.any()) {
         lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
-      if (FLAGS_write_bag && run.source.rfind("ros2bag:", 0) == 0) {
-        io::WriteOdometryRos2Bag(out + "/trajectory_bag", run.trajectory);
-        files.Add(out + "/trajectory_bag", "the estimate as nav_msgs/Odometry (ROS 2 bag, MCAP)");
-      } else if (FLAGS_write_bag) {
-        io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
-        files.Add(out + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)");
+      if (FLAGS_write_bag) {
+        const auto [bag, what] = io::WriteEstimateBag(out, run.source, run.trajectory);
+        files.Add(bag, what);
       }
       if (map) {
         const std::string map_path = lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1);

@@ -75,4 +75,15 @@ void WriteOdometryRos2Bag(const std::string& path, const std::vector<StampedPose
   writer->Close();
 }
 
+std::pair<std::string, std::string> WriteEstimateBag(const std::string& out_dir,
+                                                     const std::string& source_name,
+                                                     const std::vector<StampedPose>& trajectory) {
+  if (source_name.rfind("ros2bag:", 0) == 0) {
+    WriteOdometryRos2Bag(out_dir + "/trajectory_bag", trajectory);
+    return {out_dir + "/trajectory_bag", "the estimate as nav_msgs/Odometry (ROS 2 bag, MCAP)"};
+  }
+  WriteOdometryBag(out_dir + "/trajectory.bag", trajectory);
+  return {out_dir + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)"};
+}
+
 }  // namespace ctlio::io

@@ -68,7 +68,7 @@ using Ros2ContainerOpener = std::function<std::unique_ptr<Ros2Container>()>;
 std::unique_ptr<BagStream> OpenRos2BagStream(const std::string& path, Ros2ContainerOpener open);
 // A ROS 2 bag folder, .mcap or .db3 file through Ros2BagReader.
 std::unique_ptr<BagStream> OpenRos2BagStream(const std::string& path);
-// True if `path` is a ROS 2 bag (ros2::IsRos2Bag) and ROS 2 bags can be read in this build.
+// True if `path` is a ROS 2 bag (ros2::IsRos2Bag).
 bool IsRos2BagPath(const std::string& path);
 
 }  // namespace ctlio::io

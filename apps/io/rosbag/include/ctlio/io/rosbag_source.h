@@ -30,6 +30,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ctlio/io/bag_stream.h"
@@ -126,5 +127,12 @@ void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& t
                       const std::string& topic = "/ctlio/odometry",
                       const std::string& frame = "map",
                       const std::string& child_frame = "os_lidar");
+
+// ctlio_odometry --write_bag: the estimate in `out_dir` as a bag of the input's kind — a ROS 2 bag
+// folder `trajectory_bag/` when `source_name` (DataSource::Name) is a ROS 2 bag's ("ros2bag:..."),
+// else the ROS 1 bag `trajectory.bag`. Returns the path and a description for the outputs list.
+std::pair<std::string, std::string> WriteEstimateBag(const std::string& out_dir,
+                                                     const std::string& source_name,
+                                                     const std::vector<StampedPose>& trajectory);
 
 }  // namespace ctlio::io
