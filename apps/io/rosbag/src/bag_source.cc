@@ -1,3 +1,5 @@
+// BagSource (rosbag_source.h): the bag kind, topic and preset choice, the first messages' frames,
+// ground truth, and the scan-by-scan reading over the message stream (bag_stream.h).
 #include <glog/logging.h>
 
 #include <algorithm>
