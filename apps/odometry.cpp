@@ -1,6 +1,6 @@
 // ctlio_odometry: lidar-inertial odometry on a dataset folder or on the in-memory simulator.
 //
-//   ctlio_odometry --dataset DIR|FILE.bag [--format newer_college|ctlio|kitti|rosbag]
+//   ctlio_odometry --dataset DIR|FILE.bag|BAG2 [--format newer_college|ctlio|kitti|rosbag|ros2]
 //                  --method singer_lio|imu_input|lidar_gyro|lidar_only --config FILE --out DIR
 //   (a ROS 1 bag: [--lidar_topic T --imu_topic T --preset newer_college_2020|newer_college_2021
 //    --time_field F --time_unit s|ms|us|ns --time_reference relative|absolute --stamp_at
@@ -70,10 +70,10 @@
 #include "lio/run_odometry.h"
 #include "lio/run_outputs.h"
 
-DEFINE_string(dataset, "", "Dataset folder or ROS 1 bag file (not used with --format sim)");
+DEFINE_string(dataset, "", "Dataset folder, ROS 1 bag or ROS 2 bag (folder, .mcap, .db3)");
 DEFINE_string(
     format, "",
-    "newer_college | ctlio | kitti | rosbag | sim (default: detect from the folder/file)");
+    "newer_college | ctlio | kitti | rosbag | ros2 | sim (default: detect from the folder/file)");
 DEFINE_string(lidar_topic, "",
               "rosbag: PointCloud2 topic (default: the only one, or the preset's)");
 DEFINE_string(imu_topic, "", "rosbag: Imu topic (default: the only one, or the preset's)");
@@ -93,7 +93,9 @@ DEFINE_double(trajectory_rate, 0.0,
               "poses from the final estimates (Singer-LIO: GP interpolation; baseline: IMU "
               "propagation anchored at both states), and trajectory_dense_live.tum, the live "
               "(causal) one; 0 = off");
-DEFINE_bool(write_bag, false, "Also write the estimate as nav_msgs/Odometry into trajectory.bag");
+DEFINE_bool(
+    write_bag, false,
+    "Also write the estimate as nav_msgs/Odometry: trajectory.bag (ROS 2: trajectory_bag/)");
 DEFINE_string(method, "singer_lio",
               "singer_lio | imu_input | lidar_gyro | lidar_only, or a comma-separated list");
 DEFINE_string(config, "",
@@ -220,8 +222,10 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     return std::make_unique<sim::SimulatedSource>(c, name.str());
   }
   if (FLAGS_dataset.empty()) throw std::runtime_error("--dataset is required (or --format sim)");
-  if (FLAGS_format == "rosbag" || (FLAGS_format.empty() && io::IsRosbagFile(FLAGS_dataset))) {
-    io::RosbagOptions o;
+  if (FLAGS_format == "rosbag" || FLAGS_format == "ros2" ||
+      (FLAGS_format.empty() && io::IsBagPath(FLAGS_dataset))) {
+    io::BagOptions o;
+    o.format = FLAGS_format;
     o.lidar_topic = FLAGS_lidar_topic;
     o.imu_topic = FLAGS_imu_topic;
     o.preset = FLAGS_preset;
@@ -232,11 +236,11 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     if (!FLAGS_time_reference.empty())
       o.time.reference = io::ParseTimeReference(FLAGS_time_reference);
     if (!FLAGS_stamp_at.empty()) o.time.stamp_at = io::ParseStampAt(FLAGS_stamp_at);
-    return std::make_unique<io::RosbagSource>(FLAGS_dataset, o);
+    return std::make_unique<io::BagSource>(FLAGS_dataset, o);
   }
   if (!std::filesystem::is_directory(FLAGS_dataset)) {
     throw std::runtime_error(FLAGS_dataset + (std::filesystem::exists(FLAGS_dataset)
-                                                  ? ": neither a dataset folder nor a ROS 1 bag"
+                                                  ? ": neither a dataset folder nor a ROS bag"
                                                   : ": dataset folder or bag does not exist"));
   }
   if (FLAGS_format.empty()) return io::OpenDataset(FLAGS_dataset, gap_ns);
@@ -248,7 +252,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
   if (FLAGS_format == "ctlio") return std::make_unique<io::SimFolderReader>(FLAGS_dataset, gap_ns);
   if (FLAGS_format == "kitti") return std::make_unique<io::KittiReader>(FLAGS_dataset);
   throw std::runtime_error("unknown --format '" + FLAGS_format +
-                           "' (newer_college, ctlio, kitti, rosbag, sim)");
+                           "' (newer_college, ctlio, kitti, rosbag, ros2, sim)");
 }
 
 #ifndef CTLIO_TOOLS_DIR
@@ -450,8 +454,8 @@ int main(int argc, char** argv) {
         lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
       if (FLAGS_write_bag) {
-        io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
-        files.Add(out + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)");
+        const auto [bag, what] = io::WriteEstimateBag(out, run.source, run.trajectory);
+        files.Add(bag, what);
       }
       if (map) {
         const std::string map_path = lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1);

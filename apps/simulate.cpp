@@ -1,7 +1,8 @@
 // ctlio_simulate: writes one sequence of the lidar-inertial simulator (SPEC §6) as a dataset
 // folder, in ctlio's own layout (default) or the Newer College 2020 layout, with ground truth, or
 // as a ROS 1 bag (--layout rosbag: --output is the .bag file; ground truth on /ground_truth and in
-// <output without .bag>_ground_truth.tum).
+// <output without .bag>_ground_truth.tum) or a ROS 2 bag folder (--layout ros2: MCAP, or
+// ros2_sqlite3: SQLite; ground truth also in <output>_ground_truth.tum).
 //
 //   ctlio_simulate --regime=fast --index=3 --output=/tmp/fast_03 [--layout=newer_college]
 //                  [--firing_decimation=4] [--duration=20] [--body_centric] [--pillars=4]
@@ -28,6 +29,7 @@
 
 #include "common/command_line.h"
 #include "common/preset_flags.h"
+#include "ctlio/io/bag_writer.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
@@ -40,8 +42,12 @@
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
 DEFINE_string(preset, "", "Recording preset: none | newer_college (explicit flags override it)");
-DEFINE_string(layout, "ctlio", "Layout: ctlio | newer_college | rosbag (a .bag file)");
-DEFINE_string(bag_compression, "none", "--layout rosbag: chunk compression none | lz4 | bz2");
+DEFINE_string(layout, "ctlio",
+              "Layout: ctlio | newer_college | rosbag (a .bag file) | ros2 (a ROS 2 bag folder, "
+              "MCAP) | ros2_sqlite3 (a ROS 2 bag folder, SQLite)");
+DEFINE_string(bag_compression, "none",
+              "--layout rosbag: chunk compression none | lz4 | bz2; --layout ros2: none | zstd | "
+              "lz4");
 DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | vehicle");
 DEFINE_string(world, "box", "World: box | street | corridor | park | indoor");
 DEFINE_uint64(world_seed, ctlio::sim::kExperimentSeed, "Seed of the world's geometry");
@@ -151,11 +157,12 @@ ctlio::Vec3 ParseVec3(const std::string& flag, const std::string& text) {
 
 constexpr char kUsage[] =
     "ctlio_simulate: writes one sequence of the lidar-inertial simulator as a dataset folder\n"
-    "(ctlio's layout or Newer College's) or as a ROS 1 bag, with ground truth.\n"
+    "(ctlio's layout or Newer College's) or as a ROS 1 or ROS 2 bag, with ground truth.\n"
     "\n"
     "  ctlio_simulate --regime=fast --index=3 --output=/tmp/fast_03 [--layout=newer_college]\n"
     "  ctlio_simulate --world=street --regime=vehicle --output=/tmp/street --topview=street.svg\n"
-    "  ctlio_simulate --preset=newer_college --layout=rosbag --output=/tmp/nc_00.bag";
+    "  ctlio_simulate --preset=newer_college --layout=rosbag --output=/tmp/nc_00.bag\n"
+    "  ctlio_simulate --layout=ros2 --bag_compression=zstd --output=/tmp/fast_00_ros2";
 
 int main(int argc, char** argv) {
   ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
@@ -177,6 +184,9 @@ int main(int argc, char** argv) {
     if (FLAGS_layout == "rosbag") {
       RequireInRange("start_s", FLAGS_start_s, 0.0, 4.29e9,
                      " s (a ROS 1 bag's times are unsigned 32-bit seconds)");
+    } else if (FLAGS_layout == "ros2" || FLAGS_layout == "ros2_sqlite3") {
+      RequireInRange("start_s", FLAGS_start_s, 0.0, 2.147e9,
+                     " s (a ROS 2 message's times are signed 32-bit seconds)");
     } else {
       RequireInRange("start_s", FLAGS_start_s, -9.2e9, 9.2e9,
                      " s (times are int64 nanoseconds, at most ±9.22e9 s)");
@@ -325,10 +335,13 @@ int main(int argc, char** argv) {
     // The truth of what the data carry wrong (the nominal extrinsic, IMU 0's stamps), beside
     // the layouts that have no place for it (ctlio_sim.yaml records it in the ctlio layout).
     std::string truth_path;
+    const bool ros2 = FLAGS_layout == "ros2" || FLAGS_layout == "ros2_sqlite3";
     if (FLAGS_layout == "rosbag") {
       std::string stem = FLAGS_output;
       if (stem.size() > 4 && stem.substr(stem.size() - 4) == ".bag") stem.resize(stem.size() - 4);
       truth_path = stem + "_true_calibration.yaml";
+    } else if (ros2) {
+      truth_path = FLAGS_output + "_true_calibration.yaml";  // beside the bag folder
     } else if (FLAGS_layout == "newer_college") {
       truth_path = FLAGS_output + "/true_calibration.yaml";
     }
@@ -346,6 +359,21 @@ int main(int argc, char** argv) {
         std::string stem = FLAGS_output;
         if (stem.size() > 4 && stem.substr(stem.size() - 4) == ".bag") stem.resize(stem.size() - 4);
         io::WriteTum(stem + "_ground_truth.tum", *source.GroundTruth());
+      }
+    } else if (ros2) {
+      io::RosbagWriteOptions o;
+      o.write_ground_truth = FLAGS_ground_truth;
+      io::Ros2WriteOptions r;
+      r.storage =
+          FLAGS_layout == "ros2" ? io::ros2::Ros2Storage::kMcap : io::ros2::Ros2Storage::kSqlite3;
+      r.compression = io::ParseRos2Compression(FLAGS_bag_compression);
+      if (r.storage != io::ros2::Ros2Storage::kMcap &&
+          r.compression != io::ros2::Ros2Compression::kNone) {
+        throw std::runtime_error("--bag_compression applies to --layout ros2 (MCAP) only");
+      }
+      n = io::WriteRos2Bag(source, FLAGS_output, o, r, progress);
+      if (FLAGS_ground_truth) {
+        io::WriteTum(FLAGS_output + "_ground_truth.tum", *source.GroundTruth());
       }
     } else {
       throw std::runtime_error("unknown --layout '" + FLAGS_layout + "'");

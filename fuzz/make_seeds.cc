@@ -5,8 +5,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
+#include "ctlio/io/bag_writer.h"
+#include "ctlio/io/cdr_livox.h"
+#include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/io/ros2_bag.h"
@@ -157,6 +161,57 @@ int main(int argc, char** argv) {
       o.compression = compression;
       io::WriteRosbag(bag_source, (work / "s.bag").string(), o);
       Seed(corpus, "rosbag", compression, Read(work / "s.bag"));
+    }
+    {
+      // fuzz_cdr_messages: the first message of each type as WriteRos2Bag encodes it, after the
+      // byte that picks the type (fuzz_cdr_messages.cc); PoseStamped from the first pose.
+      struct FirstOfEach : io::Ros2ContainerWriter {
+        std::vector<std::string> types;
+        std::map<std::string, std::string> first;
+        size_t AddTopic(const std::string&, const std::string& type) override {
+          types.push_back(type);
+          return types.size() - 1;
+        }
+        void Write(size_t topic, int64_t, const std::vector<uint8_t>& data) override {
+          first.emplace(types[topic], std::string(data.begin(), data.end()));
+        }
+        void Close() override {}
+      } messages;
+      sim::SimulatedSource bag_source(Tiny());
+      io::WriteRos2Bag(bag_source, messages);
+      const char* kTypes[] = {"sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Imu",
+                              "tf2_msgs/msg/TFMessage", "nav_msgs/msg/Odometry"};
+      for (char k = 0; k < 4; ++k) {
+        Seed(corpus, "cdr_messages", std::to_string(int(k)), k + messages.first.at(kTypes[int(k)]));
+      }
+      const std::string& odometry = messages.first.at(kTypes[3]);
+      nav_msgs::Odometry o;
+      io::ros2::DecodeCdr(reinterpret_cast<const uint8_t*>(odometry.data()), odometry.size(), "",
+                          &o);
+      geometry_msgs::PoseStamped p;
+      p.header = o.header;
+      p.pose = o.pose.pose;
+      for (const auto e : {io::ros2::CdrEndian::kLittle, io::ros2::CdrEndian::kBig}) {
+        const std::vector<uint8_t> b = io::ros2::EncodeCdr(p, e);
+        Seed(corpus, "cdr_messages", e == io::ros2::CdrEndian::kBig ? "4_be" : "4",
+             char(4) + std::string(b.begin(), b.end()));
+      }
+      // A Livox CustomMsg: the first scan's first 16 points, offsets from the scan start.
+      sim::SimulatedSource livox_source(Tiny());
+      io::ScanFrame f;
+      livox_source.Next(&f);
+      io::ros2::LivoxCustomMsg livox;
+      livox.header.stamp.fromNSec(uint64_t(f.start_ns));
+      livox.header.frame_id = "livox_frame";
+      livox.timebase = uint64_t(f.start_ns);
+      for (size_t i = 0; i < f.cloud.size() && i < 16; ++i) {
+        const Vec3& q = f.cloud.points[i];
+        livox.points.push_back({uint32_t(f.cloud.times_ns[i] - f.start_ns), float(q.x()),
+                                float(q.y()), float(q.z()), 100, 16, uint8_t(i % 4)});
+      }
+      livox.point_num = uint32_t(livox.points.size());
+      const std::vector<uint8_t> lb = io::ros2::EncodeCdr(livox);
+      Seed(corpus, "cdr_messages", "5", char(5) + std::string(lb.begin(), lb.end()));
     }
     sim::SimulatedSource ros2_source(Tiny());
     SeedRos2(corpus, work, &ros2_source);

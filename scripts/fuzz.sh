@@ -18,8 +18,9 @@ build_dir=${2:-build-fuzz}
 # rosbag: RosbagSource over Debian's uninstrumented librosbag, behind ctlio's bag structure check
 # (docs/developer-guide/fuzzing.md); 5 minutes clean when it was added.
 # pointcloud2: structure-aware, edits the decoded fields of a simulated PointCloud2 message.
+# cdr_messages: the ROS 2 message decoders (cdr_messages.h) on arbitrary bytes, type by first byte.
 # mcap, ros2_sqlite: the ROS 2 bag containers (apps/io/ros2), seeded by ctlio's own writers.
-targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config euroc rosbag pointcloud2 mcap ros2_sqlite"}
+targets=${CTLIO_FUZZ_TARGETS:-"pcd ply kitti_bin table trajectory sim_folder newer_college kitti_folder yaml_config euroc rosbag pointcloud2 cdr_messages mcap ros2_sqlite"}
 bash scripts/install_deps.sh
 
 start=$(date +%s)

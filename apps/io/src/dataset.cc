@@ -214,11 +214,12 @@ void RegisterDatasetFileOpener(DatasetFileOpener opener) { FileOpener() = opener
 std::unique_ptr<DataSource> OpenDataset(const std::string& path, int64_t max_imu_gap_error_ns) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (fs::is_regular_file(path, ec)) {
+  // A ROS 2 bag is a folder with metadata.yaml (or one .mcap/.db3 file): the bag opener's.
+  if (fs::is_regular_file(path, ec) || fs::is_regular_file(fs::path(path) / "metadata.yaml", ec)) {
     if (FileOpener() != nullptr) return FileOpener()(path, max_imu_gap_error_ns);
     throw std::runtime_error(path +
-                             ": a file, not a dataset folder (ROS 1 bags are opened when "
-                             "ctlio::io_rosbag is linked)");
+                             ": a file or ROS 2 bag, not a dataset folder (ROS 1 and ROS 2 bags "
+                             "are opened when ctlio::io_rosbag is linked)");
   }
   if (!fs::is_directory(path, ec)) {
     throw std::runtime_error(path + ": dataset folder or bag not found");
@@ -233,7 +234,8 @@ std::unique_ptr<DataSource> OpenDataset(const std::string& path, int64_t max_imu
   }
   if (fs::is_directory(fs::path(path) / "velodyne")) return std::make_unique<KittiReader>(path);
   throw std::runtime_error(path +
-                           ": not a dataset folder (no ctlio_sim.yaml, raw_format/ or velodyne/)");
+                           ": not a dataset folder (no ctlio_sim.yaml, raw_format/ or velodyne/) "
+                           "nor a ROS 2 bag folder (no metadata.yaml)");
 }
 
 }  // namespace ctlio::io

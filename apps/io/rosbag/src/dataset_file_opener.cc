@@ -1,5 +1,6 @@
 // Registers the bag reader as OpenDataset's file opener (dataset.h), so that a program linking
-// ctlio::io_rosbag opens `x.bag` with OpenDataset as ctlio_odometry does without --format: the
+// ctlio::io_rosbag opens `x.bag`, a ROS 2 bag folder, `.mcap` or `.db3` with OpenDataset as
+// ctlio_odometry does without --format (BagSource detects which): the
 // only PointCloud2 and Imu topics (or a preset's), the extrinsic from /tf_static or the preset.
 //
 // A static library's object is linked only when something references it; nothing calls into

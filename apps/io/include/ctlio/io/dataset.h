@@ -134,9 +134,9 @@ bool SecondsToNs(double s, int64_t* ns);
 bool SecNsecToNs(int64_t sec, int64_t nsec, int64_t* ns);
 
 // Opens any supported dataset by looking at it: a folder of Newer College 2020 (raw_format/),
-// ctlio's simulator (ctlio_sim.yaml) or KITTI (velodyne/), or a file handed to the registered
-// file opener (a ROS 1 bag, with ctlio::io_rosbag linked: rosbag_source.h, topics and extrinsic
-// found as ctlio_odometry finds them without flags). Throws naming `path` if none matches.
+// ctlio's simulator (ctlio_sim.yaml) or KITTI (velodyne/), or a file or ROS 2 bag folder handed
+// to the registered file opener (ROS 1/2 bags with ctlio::io_rosbag linked: rosbag_source.h, as
+// ctlio_odometry finds them without flags). Throws naming `path` if none matches.
 // `max_imu_gap_error_ns`: the readers' opt-in IMU gap error (0 = gaps are warnings).
 std::unique_ptr<DataSource> OpenDataset(const std::string& path, int64_t max_imu_gap_error_ns = 0);
 

@@ -1,12 +1,16 @@
-// ROS 1 bags (sensor_msgs/PointCloud2 + sensor_msgs/Imu) as a DataSource, read with ROS's own bag
-// library (rosbag::Bag, rosbag::View), streamed message by message: only the bag's index and the
-// scans waiting for their IMU samples are in memory, so a bag of tens of GB is fine.
+// ROS bags (sensor_msgs/PointCloud2 + sensor_msgs/Imu) as a DataSource: ROS 1 bags read with
+// ROS's own bag library (rosbag::Bag, rosbag::View) and ROS 2 bags (a folder with metadata.yaml,
+// a .mcap or a .db3 file: ros2_bag.h, messages in CDR: cdr_messages.h), both through the message
+// stream of bag_stream.h, so that everything below is one code for both. Streamed message by
+// message: only the bag's index and the scans waiting for their IMU samples are in memory, so a
+// bag of tens of GB is fine.
 //
 // Topics: --lidar_topic / --imu_topic; left empty, the only PointCloud2 and the only Imu topic of
 // the bag are used (several candidates: an error listing them). A dataset preset (Newer College
 // 2020/2021, chosen by name or recognised from its topic names) supplies topic names and the
 // extrinsic. Per-point times: point_fields.h (detected from the fields, overridable); a cloud
-// without a time field gets azimuth times (logged once).
+// without a time field gets azimuth times (logged once). Ground truth: nav_msgs/Odometry or
+// geometry_msgs/PoseStamped on `ground_truth_topic`.
 //
 // Extrinsic T_imu_lidar, in this order (ImuFromLidar, ExtrinsicOrigin):
 //   1. (the caller's explicit config value, applied by the odometry runner, not here)
@@ -26,8 +30,10 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "ctlio/io/bag_stream.h"
 #include "ctlio/io/dataset.h"
 #include "ctlio/io/point_fields.h"
 
@@ -42,7 +48,9 @@ struct BagPreset {
 };
 const std::vector<BagPreset>& BagPresets();
 
-struct RosbagOptions {
+struct BagOptions {
+  // "" detects the bag kind from the path; "rosbag" (ROS 1) or "ros2" forces it.
+  std::string format;
   std::string lidar_topic, imu_topic;  // empty: the only topic of that type, or the preset's
   std::string preset;                  // empty: recognised from the topics (or none)
   TimeFieldOptions time;
@@ -51,17 +59,25 @@ struct RosbagOptions {
   // Multiplies the accelerometer: 9.80665 for IMUs that report g (Livox), whose mean specific
   // force near 1 is warned about.
   double accel_scale = 1.0;
-  // Ground truth T_world_lidar read from this topic (nav_msgs/Odometry) when the bag has it.
+  // Ground truth T_world_lidar read from this topic (nav_msgs/Odometry or
+  // geometry_msgs/PoseStamped) when the bag has it.
   std::string ground_truth_topic = "/ground_truth";
 };
+using RosbagOptions = BagOptions;
 
 // True if `path` is a regular file starting with the ROS 1 bag magic "#ROSBAG V2.0".
 bool IsRosbagFile(const std::string& path);
+// True if `path` is a ROS 1 bag or a ROS 2 bag (IsRos2BagPath, bag_stream.h).
+bool IsBagPath(const std::string& path);
 
-class RosbagSource : public DataSource {
+class BagSource : public DataSource {
  public:
-  explicit RosbagSource(const std::string& path, const RosbagOptions& options = {});
-  ~RosbagSource() override;
+  // A ROS 1 bag file or a ROS 2 bag (folder, .mcap, .db3), as options.format says or detected.
+  explicit BagSource(const std::string& path, const BagOptions& options = {});
+  // Any message stream (tests: a ROS 2 container in memory); `path` names it in errors.
+  BagSource(const std::string& path, std::unique_ptr<BagStream> stream,
+            const BagOptions& options = {});
+  ~BagSource() override;
   std::string Name() const override;
   size_t NumScans() const override;
   bool Next(ScanFrame* frame) override;
@@ -86,6 +102,8 @@ class RosbagSource : public DataSource {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+// The name of the ROS 1 era, for the callers that read ROS 1 bags.
+using RosbagSource = BagSource;
 
 struct RosbagWriteOptions {
   std::string lidar_topic = "/os_cloud_node/points";  // ouster_ros names
@@ -110,5 +128,12 @@ void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& t
                       const std::string& topic = "/ctlio/odometry",
                       const std::string& frame = "map",
                       const std::string& child_frame = "os_lidar");
+
+// ctlio_odometry --write_bag: the estimate in `out_dir` as a bag of the input's kind — a ROS 2 bag
+// folder `trajectory_bag/` when `source_name` (DataSource::Name) is a ROS 2 bag's ("ros2bag:..."),
+// else the ROS 1 bag `trajectory.bag`. Returns the path and a description for the outputs list.
+std::pair<std::string, std::string> WriteEstimateBag(const std::string& out_dir,
+                                                     const std::string& source_name,
+                                                     const std::vector<StampedPose>& trajectory);
 
 }  // namespace ctlio::io
