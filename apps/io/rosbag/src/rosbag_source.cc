@@ -19,6 +19,7 @@
 #include "ctlio/io/bag_structure.h"
 #include "ctlio/io/extrinsic_check.h"
 #include "ctlio/io/ground_truth_check.h"
+#include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/point_time_check.h"
 #include "ctlio/io/pointcloud2.h"
@@ -160,6 +161,7 @@ struct RosbagSource::Impl {
   rosbag::View::iterator it;
   bool exhausted = false;
   std::string lidar_topic, imu_topic, lidar_frame, imu_frame;
+  bool custom_msg = false;  // the lidar topic is livox_ros_driver2/CustomMsg (livox_custom_msg.h)
   size_t num_scans = 0, lidar_messages = 0, imu_messages = 0, next_index = 0;
   std::deque<ScanFrame> pending;
   std::vector<ImuSample> imu;  // samples not yet handed out
@@ -223,8 +225,10 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
       if (topics.count(p.lidar_topic) && topics.count(p.imu_topic)) s.preset = &p;
     }
   }
-  s.lidar_topic = PickTopic(topics, kPointCloud2, options.lidar_topic,
-                            s.preset ? s.preset->lidar_topic : "", "lidar_topic", path);
+  s.custom_msg = livox::IsCustomMsgLidar(topics, options.lidar_topic);
+  s.lidar_topic =
+      PickTopic(topics, s.custom_msg ? livox::kCustomMsgType : kPointCloud2, options.lidar_topic,
+                s.preset ? s.preset->lidar_topic : "", "lidar_topic", path);
   s.imu_topic = PickTopic(topics, kImu, options.imu_topic, s.preset ? s.preset->imu_topic : "",
                           "imu_topic", path);
   if (s.preset) LOG(INFO) << path << ": preset " << s.preset->name << " (" << s.preset->note << ")";
@@ -232,9 +236,9 @@ RosbagSource::RosbagSource(const std::string& path, const RosbagOptions& options
     rosbag::View lidar(s.bag, rosbag::TopicQuery(s.lidar_topic));
     s.num_scans = lidar.size();
     if (lidar.begin() != lidar.end()) {
-      s.lidar_frame = ReadCheckedMessage<sensor_msgs::PointCloud2>(
-                          *lidar.begin(), s.Where(s.lidar_topic, 1), CheckPointCloud2Wire)
-                          .header.frame_id;
+      s.lidar_frame =
+          livox::ReadLidarMessage(*lidar.begin(), s.custom_msg, s.Where(s.lidar_topic, 1))
+              .header.frame_id;
     }
     rosbag::View imu(s.bag, rosbag::TopicQuery(s.imu_topic));
     if (imu.begin() != imu.end()) {
@@ -500,7 +504,7 @@ void RosbagSource::Impl::ReadOne() {
       AddImu(ReadCheckedMessage<sensor_msgs::Imu>(m, where, nullptr));
     } else {
       where = Where(lidar_topic, ++lidar_messages);
-      AddScan(ReadCheckedMessage<sensor_msgs::PointCloud2>(m, where, CheckPointCloud2Wire));
+      AddScan(livox::ReadLidarMessage(m, custom_msg, where));
     }
     ++it;
     exhausted = it == view->end();

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <stdexcept>
 
+#include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/rosbag_source.h"
 
@@ -62,10 +63,10 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
       throw std::runtime_error(path + ": unknown bag compression '" + options.compression +
                                "' (none, lz4, bz2)");
     }
+    if (!(options.accel_unit > 0.0)) throw std::runtime_error(path + ": accel_unit must be > 0");
     uint32_t point_step = 0;
-    const std::vector<PointField> fields = OusterFields(&point_step);
-    TimeConvention ouster;
-    ouster.field = "t";
+    const std::vector<PointField> fields = DriverFields(options.point_format, &point_step);
+    const TimeConvention time = DriverTime(options.point_format);
     ScanFrame frame;
     size_t n = 0;
     bool first = true;
@@ -93,17 +94,23 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
         m.angular_velocity.x = s.gyro.x();
         m.angular_velocity.y = s.gyro.y();
         m.angular_velocity.z = s.gyro.z();
-        m.linear_acceleration.x = s.accel.x();
-        m.linear_acceleration.y = s.accel.y();
-        m.linear_acceleration.z = s.accel.z();
+        m.linear_acceleration.x = s.accel.x() / options.accel_unit;
+        m.linear_acceleration.y = s.accel.y() / options.accel_unit;
+        m.linear_acceleration.z = s.accel.z() / options.accel_unit;
         bag.write(options.imu_topic, m.header.stamp, m);
       }
-      // Stamp = scan start, as the Ouster driver does; recorded at the scan end (when a driver
-      // would publish it).
-      frame.cloud.stamp_ns = frame.start_ns;
-      const auto msg =
-          EncodePointCloud2(frame.cloud, fields, point_step, ouster, options.lidar_frame);
-      bag.write(options.lidar_topic, RosTime(frame.end_ns), msg);
+      // Stamp = scan start as the Ouster, Hesai and Livox drivers do (Velodyne's: the scan end);
+      // recorded at the scan end (when a driver would publish it).
+      frame.cloud.stamp_ns = time.stamp_at == StampAt::kScanEnd ? frame.end_ns : frame.start_ns;
+      RosTime(frame.cloud.stamp_ns);  // a time the bag can hold (checked before encoding)
+      if (options.point_format == PointFormat::kLivoxCustomMsg) {
+        bag.write(options.lidar_topic, RosTime(frame.end_ns),
+                  livox::FromPointCloud(frame.cloud, options.lidar_frame));
+      } else {
+        const auto msg =
+            EncodePointCloud2(frame.cloud, fields, point_step, time, options.lidar_frame);
+        bag.write(options.lidar_topic, RosTime(frame.end_ns), msg);
+      }
       ++n;
       if (progress) progress(n, source.NumScans());
     }

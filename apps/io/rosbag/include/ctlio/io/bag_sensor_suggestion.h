@@ -1,0 +1,17 @@
+// The sensor suggestion of sensor_suggestion.h for a ROS 1 bag: its topics, the lidar topic's
+// type and first message (fields and points). Advisory: any error reading the bag gives no
+// suggestion (the reader itself reports it).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "ctlio/io/sensor_suggestion.h"
+
+namespace ctlio::io {
+
+// `lidar_topic`: the topic the reader chose (RosbagSource::lidar_topic()).
+std::optional<SensorSuggestion> SuggestSensorConfigForBag(const std::string& path,
+                                                          const std::string& lidar_topic);
+
+}  // namespace ctlio::io
