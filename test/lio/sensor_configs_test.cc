@@ -1,5 +1,5 @@
 // The shipped per-sensor configs (data/sensors/<sensor>.yaml): one per simulator sensor model,
-// each loads through its base, carries its sensor's IMU rate and noise, and an extrinsic exactly
+// each loads through its base, carries its sensor's IMU rate and a noise no lower than its own, and an extrinsic exactly
 // where the device fixes one (Ouster, Livox): never for an external IMU (Velodyne, Hesai), whose
 // recording's /tf_static a config extrinsic would silently override.
 #include <gtest/gtest.h>
@@ -23,8 +23,10 @@ TEST(SensorConfigs, OnePerModelWithItsImuAndExtrinsic) {
     ASSERT_TRUE(std::filesystem::is_regular_file(path));
     const OdometryConfig c = LoadOdometryConfig(path);
     EXPECT_EQ(c.imu_rate_hint, m.imu_rate_hz);
-    EXPECT_NEAR(c.input_accel_sigma, m.accel_noise, 1e-3 * m.accel_noise + 1e-6);
-    EXPECT_NEAR(c.input_gyro_sigma, m.gyro_noise, 1e-3 * m.gyro_noise + 1e-7);
+    // The baseline's σ: never below the device's (the files inflate it for preintegration and
+    // gait errors, measured in docs/experiments/sensors.md).
+    EXPECT_GE(c.input_accel_sigma, m.accel_noise);
+    EXPECT_GE(c.input_gyro_sigma, m.gyro_noise);
     EXPECT_LE(c.frontend.max_range, m.lidar.max_range);
     const bool built_in_imu =
         m.driver.format != io::PointFormat::kVelodyne && m.driver.format != io::PointFormat::kHesai;
