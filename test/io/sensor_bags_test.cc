@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
 
 #include <cmath>
 #include <filesystem>
@@ -126,6 +127,37 @@ TEST(SensorBags, LivoxImuIsInG) {
   ASSERT_TRUE(read.Next(&f));
   ASSERT_FALSE(f.imu.empty());
   EXPECT_NEAR(f.imu.front().accel.norm(), 9.81 / 9.80665, 0.02);
+}
+
+// A CustomMsg whose point_num disagrees with its points (a corrupt message) is an error naming the
+// bag, topic and message, not a crash or a silent cloud.
+TEST(SensorBags, CorruptCustomMsgInABagIsAnError) {
+  const fs::path d = testing::FreshTempDir("sensor_bags_corrupt");
+  const std::string path = (d / "bad.bag").string();
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    PointCloud c;
+    c.stamp_ns = 1'000'000'000;
+    c.points = {Vec3(1, 2, 3), Vec3(4, 5, 6)};
+    c.times_ns = {c.stamp_ns, c.stamp_ns + 10};
+    livox::CustomMsg m = livox::FromPointCloud(c, "livox_frame");
+    m.point_num = 3;
+    ros::Time t;
+    t.fromNSec(1'100'000'000);
+    bag.write("/livox/lidar", t, m);
+    sensor_msgs::Imu imu;
+    imu.header.stamp = t;
+    bag.write("/livox/imu", t, imu);
+  }
+  try {
+    RosbagSource read(path);
+    ScanFrame f;
+    read.Next(&f);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("/livox/lidar, message 1"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("point_num 3 but 2 points"));
+  }
 }
 
 // Every sensor's bag, as its driver writes it, suggests that sensor's shipped config; the config
