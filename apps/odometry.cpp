@@ -124,10 +124,7 @@ DEFINE_string(association, "",
               "Override lidar_frontend.association of the config: knn | voxel_plane");
 DEFINE_string(sim_preset, "",
               "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
-DEFINE_string(sim_sensor, "",
-              "--format sim: sensor model os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | "
-              "pandar_xt32 | mid360 | avia (ctlio_simulate --sensor list; explicit --sim_* flags "
-              "win)");
+DEFINE_string(sim_sensor, "", "--format sim: sensor model (ctlio_simulate --sensor list)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
@@ -362,15 +359,7 @@ int main(int argc, char** argv) {
       config.Validate();
       ctlio::io::WarningLimiter::SetStrict(FLAGS_strict);  // before the readers read anything
       auto source = OpenSource(config.input.max_imu_gap_error);
-      if (FLAGS_config.empty() && m == methods.front()) {  // sensor_suggestion.h
-        if (const auto* bag = dynamic_cast<const io::RosbagSource*>(source.get())) {
-          if (const auto s = io::SuggestSensorConfigForBag(FLAGS_dataset, bag->lidar_topic())) {
-            LOG(INFO) << "no --config: this recording looks like sensor " << s->sensor << " ("
-                      << s->evidence << "); try --config " << s->config
-                      << (s->note.empty() ? "" : "; " + s->note);
-          }
-        }
-      }
+      if (FLAGS_config.empty() && m == methods.front()) io::LogSensorSuggestion(*source);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
       lioapp::RunOptions options;

@@ -1,10 +1,12 @@
 #include "ctlio/io/bag_sensor_suggestion.h"
 
+#include <glog/logging.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
 #include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/pointcloud2.h"
+#include "ctlio/io/rosbag_source.h"
 
 namespace ctlio::io {
 
@@ -27,6 +29,18 @@ std::optional<SensorSuggestion> SuggestSensorConfigForBag(const std::string& pat
     return SuggestSensorConfig(traits);
   } catch (const std::exception&) {
     return std::nullopt;
+  }
+}
+
+void LogSensorSuggestion(const DataSource& source) {
+  const auto* bag = dynamic_cast<const RosbagSource*>(&source);
+  const std::string prefix = "rosbag:";  // RosbagSource::Name() is "rosbag:<path>"
+  if (!bag || bag->Name().rfind(prefix, 0) != 0) return;
+  if (const auto s =
+          SuggestSensorConfigForBag(bag->Name().substr(prefix.size()), bag->lidar_topic())) {
+    LOG(INFO) << "no --config: this recording looks like sensor " << s->sensor << " ("
+              << s->evidence << "); try --config " << s->config
+              << (s->note.empty() ? "" : "; " + s->note);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "ctlio/io/dataset.h"
 #include "ctlio/io/sensor_suggestion.h"
 
 namespace ctlio::io {
@@ -13,5 +14,9 @@ namespace ctlio::io {
 // `lidar_topic`: the topic the reader chose (RosbagSource::lidar_topic()).
 std::optional<SensorSuggestion> SuggestSensorConfigForBag(const std::string& path,
                                                           const std::string& lidar_topic);
+
+// Logs the suggestion (INFO) when `source` is a RosbagSource whose recording gives its sensor
+// away; ctlio_odometry calls it when no --config is given.
+void LogSensorSuggestion(const DataSource& source);
 
 }  // namespace ctlio::io
