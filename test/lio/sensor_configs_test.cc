@@ -1,7 +1,7 @@
 // The shipped per-sensor configs (data/sensors/<sensor>.yaml): one per simulator sensor model,
-// each loads through its base, carries its sensor's IMU rate and a noise no lower than its own, and an extrinsic exactly
-// where the device fixes one (Ouster, Livox): never for an external IMU (Velodyne, Hesai), whose
-// recording's /tf_static a config extrinsic would silently override.
+// each loads through its base, carries its sensor's IMU rate and a noise no lower than its own,
+// and an extrinsic exactly where the device fixes one (Ouster, Livox): never for an external IMU
+// (Velodyne, Hesai), whose recording's /tf_static a config extrinsic would silently override.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
