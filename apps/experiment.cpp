@@ -51,6 +51,7 @@
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
+#include "ctlio/sim/sensor_models.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
 #include "lio/config_origin.h"
@@ -65,6 +66,10 @@ DEFINE_string(config, "",
               "(default: data/sim_lio.yaml of the source tree, data/newer_college_lio.yaml with "
               "--sim_preset newer_college)");
 DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes (also walking, vehicle)");
+DEFINE_string(sim_sensor, "",
+              "Sensor model os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | pandar_xt32 | mid360 | "
+              "avia (ctlio_simulate --sensor list; sets lidar, IMU and extrinsic; default config "
+              "data/sensors/<sensor>.yaml)");
 DEFINE_string(sim_preset, "",
               "Recording preset: none | newer_college (sets world, regime, sensors, IMU, duration; "
               "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
@@ -181,7 +186,7 @@ void Merge() {
 // A flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  return ctlio::apps::Given(!FLAGS_sim_preset.empty(), flag, value);
+  return ctlio::apps::Given(!FLAGS_sim_preset.empty() || !FLAGS_sim_sensor.empty(), flag, value);
 }
 
 constexpr char kUsage[] =
@@ -214,9 +219,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     std::filesystem::create_directories(FLAGS_out);
+    if (!FLAGS_sim_sensor.empty()) sim::FindSensorModel(FLAGS_sim_sensor);  // a clear error
     // Default configuration: the one written for the simulated sensors.
     const std::string config_path =
         !FLAGS_config.empty() ? FLAGS_config
+        : !FLAGS_sim_sensor.empty()
+            ? std::string(CTLIO_SOURCE_DIR) + "/data/sensors/" + FLAGS_sim_sensor + ".yaml"
         : FLAGS_sim_preset == "newer_college"
             ? std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml"
             : std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml";
@@ -232,6 +240,7 @@ int main(int argc, char** argv) {
     given.firing_decimation = Given("firing_decimation", FLAGS_firing_decimation);
     given.lidar_rate_hz = Given("lidar_rate", FLAGS_lidar_rate);
     given.body_centric = Given("body_centric", FLAGS_body_centric);
+    if (!FLAGS_sim_sensor.empty()) given.sensor = FLAGS_sim_sensor;
     const std::string world_name = sim::WorldName(given.world.value_or(sim::PresetWorld(preset)));
     const auto regimes = SplitList(
         Given("regimes", FLAGS_regimes).value_or(sim::RegimeName(sim::PresetRegime(preset))));

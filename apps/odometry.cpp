@@ -47,6 +47,7 @@
 
 #include "common/command_line.h"
 #include "common/preset_flags.h"
+#include "ctlio/io/bag_sensor_suggestion.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
@@ -126,6 +127,7 @@ DEFINE_string(association, "",
               "Override lidar_frontend.association of the config: knn | voxel_plane");
 DEFINE_string(sim_preset, "",
               "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
+DEFINE_string(sim_sensor, "", "--format sim: sensor model (ctlio_simulate --sensor list)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
 DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
@@ -189,7 +191,7 @@ using namespace ctlio;
 // A --sim_* flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  return apps::Given(!FLAGS_sim_preset.empty(), flag, value);
+  return apps::Given(!FLAGS_sim_preset.empty() || !FLAGS_sim_sensor.empty(), flag, value);
 }
 
 std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
@@ -203,6 +205,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     given.firing_decimation = Given("sim_firing_decimation", FLAGS_sim_firing_decimation);
     given.beams = Given("sim_beams", FLAGS_sim_beams);
     given.lidar_rate_hz = Given("sim_lidar_rate", FLAGS_sim_lidar_rate);
+    if (!FLAGS_sim_sensor.empty()) given.sensor = FLAGS_sim_sensor;
     sim::SimConfig c = sim::PresetConfig(preset, FLAGS_sim_index, sim::kExperimentSeed, given);
     c.imu.outages = sim::ParseImuOutages(FLAGS_sim_imu_dropout);
     c.imu.stamp_offset_s = FLAGS_sim_imu_stamp_offset;
@@ -216,6 +219,7 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     std::ostringstream name;
     name << "sim:"
          << (preset == sim::Preset::kNone ? "" : std::string(sim::PresetName(preset)) + ":")
+         << (FLAGS_sim_sensor.empty() ? "" : FLAGS_sim_sensor + ":")
          << (world == sim::WorldKind::kBox ? "" : std::string(sim::WorldName(world)) + "/")
          << sim::RegimeName(given.regime.value_or(sim::PresetRegime(preset))) << "/"
          << FLAGS_sim_index;
@@ -374,6 +378,7 @@ int main(int argc, char** argv) {
                                                ? config.input.strict
                                                : FLAGS_strict);
       auto source = OpenSource(config.input.max_imu_gap_error);
+      if (FLAGS_config.empty() && m == methods.front()) io::LogSensorSuggestion(*source);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
       lioapp::RunOptions options;

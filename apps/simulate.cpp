@@ -39,9 +39,17 @@
 #include "ctlio/sim/imu_specs.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
+#include "ctlio/sim/sensor_models.h"
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
 DEFINE_string(preset, "", "Recording preset: none | newer_college (explicit flags override it)");
+DEFINE_string(sensor, "",
+              "Sensor model: os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | pandar_xt32 | mid360 | "
+              "avia (lidar, IMU, extrinsic and, in bags, the driver's fields, topics and frames; "
+              "'list' prints them; explicit flags override it)");
+DEFINE_string(livox_format, "custom",
+              "--sensor mid360|avia, bag layouts: custom (livox_ros_driver2/CustomMsg) | "
+              "pointcloud2 (the driver's xfer_format 0)");
 DEFINE_string(layout, "ctlio",
               "Layout: ctlio | newer_college | rosbag (a .bag file) | ros2 (a ROS 2 bag folder, "
               "MCAP) | ros2_sqlite3 (a ROS 2 bag folder, SQLite)");
@@ -107,7 +115,7 @@ namespace {
 // A flag applies unless a preset is chosen and the flag was not given explicitly.
 template <class T>
 std::optional<T> Given(const char* flag, const T& value) {
-  return ctlio::apps::Given(!FLAGS_preset.empty(), flag, value);
+  return ctlio::apps::Given(!FLAGS_preset.empty() || !FLAGS_sensor.empty(), flag, value);
 }
 
 // "a,b,c" → Vec3 (one number repeats on all axes).
@@ -164,10 +172,33 @@ constexpr char kUsage[] =
     "  ctlio_simulate --preset=newer_college --layout=rosbag --output=/tmp/nc_00.bag\n"
     "  ctlio_simulate --layout=ros2 --bag_compression=zstd --output=/tmp/fast_00_ros2";
 
+namespace {
+
+// The bag writers' options: ground truth as asked, and with --sensor its driver's fields, per-point
+// time, topics, frames and accelerometer unit (the same in ROS 1 and ROS 2 bags).
+ctlio::io::RosbagWriteOptions BagWriteOptions() {
+  ctlio::io::RosbagWriteOptions o;
+  o.write_ground_truth = FLAGS_ground_truth;
+  if (!FLAGS_sensor.empty()) {
+    ctlio::io::DriverConvention d = ctlio::sim::FindSensorModel(FLAGS_sensor).driver;
+    if (d.format == ctlio::io::PointFormat::kLivoxCustomMsg && FLAGS_livox_format == "pointcloud2") {
+      d.format = ctlio::io::PointFormat::kLivoxPointCloud2;
+    }
+    o.UseDriver(d);
+  }
+  return o;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   ctlio::apps::ParseCommandLine(&argc, &argv, kUsage);
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
+  if (FLAGS_sensor == "list") {
+    std::cout << ctlio::sim::ListSensorModels();
+    return 0;
+  }
   if (FLAGS_output.empty()) {
     std::cerr << "--output is required\n";
     return 2;
@@ -203,6 +234,10 @@ int main(int argc, char** argv) {
     given.accel_bias_walk = Given("bias_walk_accel", FLAGS_bias_walk_accel);
     given.gyro_bias_walk = Given("bias_walk_gyro", FLAGS_bias_walk_gyro);
     given.newer_college_extrinsic = Given("newer_college_extrinsic", FLAGS_newer_college_extrinsic);
+    if (!FLAGS_sensor.empty()) given.sensor = FLAGS_sensor;
+    if (FLAGS_livox_format != "custom" && FLAGS_livox_format != "pointcloud2") {
+      throw std::runtime_error("--livox_format '" + FLAGS_livox_format + "': custom | pointcloud2");
+    }
     const sim::Regime regime = given.regime.value_or(sim::PresetRegime(preset));
     const sim::WorldKind world = given.world.value_or(sim::PresetWorld(preset));
     const std::string regime_name = sim::RegimeName(regime), world_name = sim::WorldName(world);
@@ -272,7 +307,8 @@ int main(int argc, char** argv) {
     }
 
     std::ostringstream yaml;
-    yaml << "{preset: " << sim::PresetName(preset) << ", world: " << world_name
+    yaml << "{preset: " << sim::PresetName(preset)
+         << (FLAGS_sensor.empty() ? "" : ", sensor: " + FLAGS_sensor) << ", world: " << world_name
          << ", world_seed: " << FLAGS_world_seed << ", regime: " << regime_name
          << ", index: " << FLAGS_index << ", seed: " << FLAGS_seed
          << ", duration_s: " << config.duration_s
@@ -351,8 +387,7 @@ int main(int argc, char** argv) {
     } else if (FLAGS_layout == "newer_college") {
       n = io::WriteNewerCollege(source, FLAGS_output, progress, FLAGS_ground_truth);
     } else if (FLAGS_layout == "rosbag") {
-      io::RosbagWriteOptions o;
-      o.write_ground_truth = FLAGS_ground_truth;
+      io::RosbagWriteOptions o = BagWriteOptions();
       o.compression = FLAGS_bag_compression;
       n = io::WriteRosbag(source, FLAGS_output, o, progress);
       if (FLAGS_ground_truth) {
@@ -361,8 +396,7 @@ int main(int argc, char** argv) {
         io::WriteTum(stem + "_ground_truth.tum", *source.GroundTruth());
       }
     } else if (ros2) {
-      io::RosbagWriteOptions o;
-      o.write_ground_truth = FLAGS_ground_truth;
+      const io::RosbagWriteOptions o = BagWriteOptions();
       io::Ros2WriteOptions r;
       r.storage =
           FLAGS_layout == "ros2" ? io::ros2::Ros2Storage::kMcap : io::ros2::Ros2Storage::kSqlite3;

@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       RoundTrip<geometry_msgs::PoseStamped>(body, n);
       break;
     default:
-      RoundTrip<LivoxCustomMsg>(body, n);
+      RoundTrip<ctlio::io::livox::CustomMsg>(body, n);
       break;
   }
   return 0;

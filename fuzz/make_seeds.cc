@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
       sim::SimulatedSource livox_source(Tiny());
       io::ScanFrame f;
       livox_source.Next(&f);
-      io::ros2::LivoxCustomMsg livox;
+      io::livox::CustomMsg livox;
       livox.header.stamp.fromNSec(uint64_t(f.start_ns));
       livox.header.frame_id = "livox_frame";
       livox.timebase = uint64_t(f.start_ns);

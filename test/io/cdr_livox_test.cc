@@ -31,7 +31,7 @@ const Bytes kCustomLe = {
 // clang-format on
 
 TEST(CdrLivox, DecodesAHandBuiltCustomMsgFieldByField) {
-  LivoxCustomMsg m;
+  livox::CustomMsg m;
   DecodeCdr(kCustomLe.data(), kCustomLe.size(), "", &m);
   EXPECT_EQ(m.header.stamp.sec, 3u);
   EXPECT_EQ(m.header.stamp.nsec, 4u);
@@ -52,14 +52,14 @@ TEST(CdrLivox, DecodesAHandBuiltCustomMsgFieldByField) {
   // Big-endian: other bytes, the same message.
   const Bytes be = EncodeCdr(m, CdrEndian::kBig);
   EXPECT_NE(be, kCustomLe);
-  LivoxCustomMsg again;
+  livox::CustomMsg again;
   DecodeCdr(be.data(), be.size(), "", &again);
   EXPECT_EQ(again, m);
 }
 
 TEST(CdrLivox, EveryTruncationAndAnImpossiblePointCountAreErrors) {
   for (size_t n = 0; n < kCustomLe.size(); ++n) {
-    LivoxCustomMsg m;
+    livox::CustomMsg m;
     try {
       DecodeCdr(kCustomLe.data(), n, "bag: topic /livox/lidar, message 2: ", &m);
       ADD_FAILURE() << "cut at " << n << " decoded";
@@ -73,7 +73,7 @@ TEST(CdrLivox, EveryTruncationAndAnImpossiblePointCountAreErrors) {
   }
   Bytes b = kCustomLe;
   b[36] = 2;  // 2 points of ≥ 19 bytes in 19 bytes
-  LivoxCustomMsg m;
+  livox::CustomMsg m;
   try {
     DecodeCdr(b.data(), b.size(), "", &m);
     ADD_FAILURE() << "decoded";

@@ -357,7 +357,7 @@ std::vector<uint8_t> EncodePoints(const PointCloud& cloud, const std::vector<Poi
         StoreValue(q, f.datatype, cloud.points[i][f.name[0] - 'x'], false, 0);
       } else if (f.name == "intensity" && cloud.intensity.size() == n) {
         StoreValue(q, f.datatype, cloud.intensity[i], false, 0);
-      } else if (f.name == "ring" && cloud.ring.size() == n) {
+      } else if ((f.name == "ring" || f.name == "line") && cloud.ring.size() == n) {
         StoreValue(q, f.datatype, cloud.ring[i], false, 0);
       } else if (f.name == "range") {
         StoreValue(q, f.datatype, cloud.points[i].norm() * 1000.0, false, 0);  // mm (Ouster)

@@ -75,12 +75,18 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
       beam_az_error_.push_back(L.azimuth_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
     }
   }
+  if (!L.elevations_deg.empty() && L.elevations_deg.size() != size_t(L.beams)) {
+    throw std::runtime_error("LidarInertialSim: " + std::to_string(L.elevations_deg.size()) +
+                             " beam elevations for " + std::to_string(L.beams) + " beams");
+  }
   for (int b = 0; b < L.beams; ++b) {
     const double el =
-        (L.beams == 1 ? L.min_elevation_deg
-                      : L.min_elevation_deg +
-                            (L.max_elevation_deg - L.min_elevation_deg) * b / (L.beams - 1)) *
-        M_PI / 180.0;
+        !L.elevations_deg.empty()
+            ? L.elevations_deg[b] * M_PI / 180.0
+            : (L.beams == 1 ? L.min_elevation_deg
+                            : L.min_elevation_deg +
+                                  (L.max_elevation_deg - L.min_elevation_deg) * b / (L.beams - 1)) *
+                  M_PI / 180.0;
     cos_el_.push_back(std::cos(el));
     sin_el_.push_back(std::sin(el));
   }
@@ -292,6 +298,7 @@ void LidarInertialSim::ApplyImuOutages(size_t j) {
 
 io::PointCloud LidarInertialSim::Scan(size_t k) const {
   const auto& L = config_.lidar;
+  if (L.pattern.kind != PatternKind::kSpinning) return PatternScan(k);
   io::PointCloud cloud;
   cloud.stamp_ns = ScanStartNs(k);
   const size_t firings =

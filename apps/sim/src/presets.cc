@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/newer_college.h"
+#include "ctlio/sim/sensor_models.h"
 
 namespace ctlio::sim {
 
@@ -53,6 +54,16 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrid
                                  o.world.value_or(PresetWorld(preset)));
   c.duration_s = PresetDuration(preset);
   if (preset == Preset::kNewerCollege) ApplyNewerCollegeSensors(&c);
+  if (o.sensor) {
+    const SensorModel& m = FindSensorModel(*o.sensor);
+    ApplySensorModel(m, &c);
+    if (o.beams && *o.beams != m.lidar.beams &&
+        (!m.lidar.elevations_deg.empty() || m.lidar.pattern.kind != PatternKind::kSpinning)) {
+      throw std::runtime_error("--beams " + std::to_string(*o.beams) +
+                               " does not apply to sensor " + m.name + " (its " +
+                               std::to_string(m.lidar.beams) + " beams are the datasheet's)");
+    }
+  }
   if (o.duration_s) c.duration_s = *o.duration_s;
   if (o.beams) c.lidar.beams = *o.beams;
   if (o.firing_decimation) c.lidar.firing_decimation = *o.firing_decimation;

@@ -12,7 +12,7 @@ constexpr size_t kMinPointBytes = 4 + 3 * 4 + 3;
 
 }  // namespace
 
-void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, LivoxCustomMsg* msg) {
+void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, livox::CustomMsg* msg) {
   CdrReader in(data, size, where, "livox_ros_driver2/msg/CustomMsg");
   ReadHeader(in, &msg->header);
   msg->timebase = in.U64("timebase");
@@ -23,7 +23,7 @@ void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, Livox
   msg->points.clear();
   msg->points.reserve(n);
   for (uint32_t i = 0; i < n; ++i) {
-    LivoxCustomPoint p;
+    livox::CustomPoint p;
     p.offset_time = in.U32("points.offset_time");
     p.x = in.F32("points.x");
     p.y = in.F32("points.y");
@@ -36,7 +36,7 @@ void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, Livox
   in.Finish();
 }
 
-std::vector<uint8_t> EncodeCdr(const LivoxCustomMsg& msg, CdrEndian endian) {
+std::vector<uint8_t> EncodeCdr(const livox::CustomMsg& msg, CdrEndian endian) {
   if (msg.points.size() > UINT32_MAX) throw std::runtime_error("CustomMsg: too many points");
   CdrWriter out(endian);
   WriteHeader(out, msg.header);
@@ -45,7 +45,7 @@ std::vector<uint8_t> EncodeCdr(const LivoxCustomMsg& msg, CdrEndian endian) {
   out.U8(msg.lidar_id);
   for (uint8_t r : msg.rsvd) out.U8(r);
   out.U32(uint32_t(msg.points.size()));
-  for (const LivoxCustomPoint& p : msg.points) {
+  for (const livox::CustomPoint& p : msg.points) {
     out.U32(p.offset_time);
     out.F32(p.x);
     out.F32(p.y);

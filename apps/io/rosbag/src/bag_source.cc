@@ -10,6 +10,7 @@
 
 #include "bag_source_impl.h"
 #include "ctlio/io/ground_truth_check.h"
+#include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/newer_college.h"
 
 namespace ctlio::io {
@@ -132,8 +133,10 @@ void BagSource::Impl::Open() {
       if (topics.count(p.lidar_topic) && topics.count(p.imu_topic)) preset = &p;
     }
   }
-  lidar_topic = PickTopic(topics, kPointCloud2, options.lidar_topic,
-                          preset ? preset->lidar_topic : "", "lidar_topic", path);
+  custom_msg = livox::IsCustomMsgLidar(topics, options.lidar_topic);
+  lidar_topic = PickTopic(topics, custom_msg ? livox::kCustomMsgType : kPointCloud2,
+                          options.lidar_topic, preset ? preset->lidar_topic : "", "lidar_topic",
+                          path);
   imu_topic = PickTopic(topics, kImu, options.imu_topic, preset ? preset->imu_topic : "",
                         "imu_topic", path);
   if (preset) LOG(INFO) << path << ": preset " << preset->name << " (" << preset->note << ")";
@@ -141,9 +144,7 @@ void BagSource::Impl::Open() {
   // The frames of the first messages name the ends of the extrinsic (ChooseExtrinsic).
   stream->Select({lidar_topic});
   if (stream->Next()) {
-    sensor_msgs::PointCloud2 first;
-    stream->Read(Where(lidar_topic, 1), &first);
-    lidar_frame = first.header.frame_id;
+    lidar_frame = livox::ReadLidarMessage(*stream, custom_msg, Where(lidar_topic, 1)).header.frame_id;
   }
   stream->Select({imu_topic});
   if (stream->Next()) {
@@ -229,9 +230,7 @@ void BagSource::Impl::ReadOne() {
     stream->Read(Where(imu_topic, imu_messages + 1), &m);
     AddImu(m);
   } else {
-    sensor_msgs::PointCloud2 m;
-    stream->Read(Where(lidar_topic, ++lidar_messages), &m);
-    AddScan(m);
+    AddScan(livox::ReadLidarMessage(*stream, custom_msg, Where(lidar_topic, ++lidar_messages)));
   }
   exhausted = !stream->Next();
 }

@@ -22,6 +22,7 @@ struct BagSource::Impl {
   std::unique_ptr<BagStream> stream;
   bool exhausted = false;
   std::string lidar_topic, imu_topic, lidar_frame, imu_frame;
+  bool custom_msg = false;  // the lidar topic is livox_ros_driver2/CustomMsg (livox_custom_msg.h)
   size_t num_scans = 0, lidar_messages = 0, imu_messages = 0, next_index = 0;
   std::deque<ScanFrame> pending;
   std::vector<ImuSample> imu;  // samples not yet handed out

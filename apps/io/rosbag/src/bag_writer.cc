@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/pointcloud2.h"
 
 namespace ctlio::io {
@@ -54,10 +55,10 @@ void WriteOdometryMessages(const std::vector<StampedPose>& trajectory, const std
 
 size_t WriteBagMessages(DataSource& source, BagMessageSink& sink, const RosbagWriteOptions& options,
                         const std::function<void(size_t, size_t)>& progress) {
+  if (!(options.accel_unit > 0.0)) throw std::runtime_error("bag writer: accel_unit must be > 0");
   uint32_t point_step = 0;
-  const std::vector<PointField> fields = OusterFields(&point_step);
-  TimeConvention ouster;
-  ouster.field = "t";
+  const std::vector<PointField> fields = DriverFields(options.point_format, &point_step);
+  const TimeConvention time = DriverTime(options.point_format);
   // Ground truth interleaved in time order (the header comment of bag_writer.h); a source that
   // knows its ground truth only at the end gets it written there.
   std::vector<StampedPose> truth;
@@ -101,18 +102,23 @@ size_t WriteBagMessages(DataSource& source, BagMessageSink& sink, const RosbagWr
       m.angular_velocity.x = s.gyro.x();
       m.angular_velocity.y = s.gyro.y();
       m.angular_velocity.z = s.gyro.z();
-      m.linear_acceleration.x = s.accel.x();
-      m.linear_acceleration.y = s.accel.y();
-      m.linear_acceleration.z = s.accel.z();
+      m.linear_acceleration.x = s.accel.x() / options.accel_unit;
+      m.linear_acceleration.y = s.accel.y() / options.accel_unit;
+      m.linear_acceleration.z = s.accel.z() / options.accel_unit;
       sink.Write(options.imu_topic, s.t_ns, m);
     }
-    // Stamp = scan start, as the Ouster driver does; recorded at the scan end (when a driver
-    // would publish it).
-    frame.cloud.stamp_ns = frame.start_ns;
-    RosTime(frame.start_ns);  // (a time before 1970 is an error here, not a wrapped stamp)
+    // Stamp = scan start as the Ouster, Hesai and Livox drivers do (Velodyne's: the scan end);
+    // recorded at the scan end (when a driver would publish it).
+    frame.cloud.stamp_ns = time.stamp_at == StampAt::kScanEnd ? frame.end_ns : frame.start_ns;
+    RosTime(frame.cloud.stamp_ns);  // (a time before 1970 is an error here, not a wrapped stamp)
     truth_until(frame.end_ns);
-    sink.Write(options.lidar_topic, frame.end_ns,
-               EncodePointCloud2(frame.cloud, fields, point_step, ouster, options.lidar_frame));
+    if (options.point_format == PointFormat::kLivoxCustomMsg) {
+      sink.Write(options.lidar_topic, frame.end_ns,
+                 livox::FromPointCloud(frame.cloud, options.lidar_frame));
+    } else {
+      sink.Write(options.lidar_topic, frame.end_ns,
+                 EncodePointCloud2(frame.cloud, fields, point_step, time, options.lidar_frame));
+    }
     ++n;
     if (progress) progress(n, source.NumScans());
   }

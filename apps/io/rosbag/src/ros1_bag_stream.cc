@@ -8,6 +8,7 @@
 
 #include "ctlio/io/bag_stream.h"
 #include "ctlio/io/bag_structure.h"
+#include "ctlio/io/livox_custom_msg.h"
 #include "ctlio/io/ros_wire_check.h"
 
 namespace ctlio::io {
@@ -81,6 +82,9 @@ class Ros1BagStream : public BagStream {
   void Read(const std::string& where, nav_msgs::Odometry* m) override { ReadAs(where, nullptr, m); }
   void Read(const std::string& where, geometry_msgs::PoseStamped* m) override {
     ReadAs(where, nullptr, m);
+  }
+  void Read(const std::string& where, livox::CustomMsg* m) override {
+    ReadAs(where, livox::CheckCustomMsgWire, m);
   }
 
  private:

@@ -5,7 +5,9 @@
 #include <stdexcept>
 
 #include "ctlio/io/bag_stream.h"
+#include "ctlio/io/cdr_livox.h"
 #include "ctlio/io/cdr_messages.h"
+#include "ctlio/io/livox_custom_msg.h"
 
 namespace ctlio::io {
 namespace {
@@ -64,6 +66,7 @@ class Ros2BagStream : public BagStream {
   void Read(const std::string& where, tf2_msgs::TFMessage* m) override { Decode(where, m); }
   void Read(const std::string& where, nav_msgs::Odometry* m) override { Decode(where, m); }
   void Read(const std::string& where, geometry_msgs::PoseStamped* m) override { Decode(where, m); }
+  void Read(const std::string& where, livox::CustomMsg* m) override { Decode(where, m); }
 
  private:
   const ros2::Ros2Topic& Current() const { return container_->topics().at(message_.topic); }

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/bag_writer.h"
+#include "ctlio/io/cdr_livox.h"
 #include "ctlio/io/cdr_messages.h"
 
 namespace ctlio::io {
@@ -19,6 +20,9 @@ class Ros2Sink : public BagMessageSink {
   }
   void Write(const std::string& topic, int64_t t, const sensor_msgs::PointCloud2& m) override {
     Put(topic, "sensor_msgs/msg/PointCloud2", t, ros2::EncodeCdr(m));
+  }
+  void Write(const std::string& topic, int64_t t, const livox::CustomMsg& m) override {
+    Put(topic, "livox_ros_driver2/msg/CustomMsg", t, ros2::EncodeCdr(m));
   }
   void Write(const std::string& topic, int64_t t, const nav_msgs::Odometry& m) override {
     Put(topic, "nav_msgs/msg/Odometry", t, ros2::EncodeCdr(m));

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/bag_writer.h"
+#include "ctlio/io/livox_custom_msg.h"
 
 namespace ctlio::io {
 namespace {
@@ -22,6 +23,9 @@ class Ros1Sink : public BagMessageSink {
     bag_->write(topic, Time(t), m);
   }
   void Write(const std::string& topic, int64_t t, const nav_msgs::Odometry& m) override {
+    bag_->write(topic, Time(t), m);
+  }
+  void Write(const std::string& topic, int64_t t, const livox::CustomMsg& m) override {
     bag_->write(topic, Time(t), m);
   }
 

@@ -37,6 +37,7 @@
 #include "ctlio/io/dataset.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/sim/guided_motion.h"
+#include "ctlio/sim/scan_pattern.h"
 #include "ctlio/sim/worlds.h"
 
 namespace ctlio::sim {
@@ -97,6 +98,13 @@ struct LidarConfig {
   // reported along the nominal ones (an uncalibrated sensor).
   double elevation_error_deg = 0.0;
   double azimuth_error_deg = 0.0;
+  // A datasheet's per-beam elevations [deg], one per beam in ring order; empty: `beams` evenly
+  // spaced over [min, max]_elevation_deg (sensor_models.h).
+  std::vector<double> elevations_deg;
+  // A non-repetitive (Livox) scan head: `beams` lines fired together at each of the
+  // firings_per_revolution firings of a frame, in directions PatternDirection (scan_pattern.h);
+  // the beam-angle errors do not apply to it.
+  ScanPattern pattern;
 };
 
 // An interval without IMU samples, in seconds since the sequence start: [start, start + length).
@@ -198,7 +206,8 @@ class LidarInertialSim {
   size_t NumScans() const;
   int64_t ScanStartNs(size_t k) const;
   int64_t FiringTimeNs(size_t k, int firing) const;
-  // Scan k in the lidar frame with absolute per-point times and ring indices.
+  // Scan k in the lidar frame with absolute per-point times and ring indices (line indices for a
+  // non-repetitive pattern).
   io::PointCloud Scan(size_t k) const;
 
   // Range along a unit ray from a world point (interior of the room, nearest obstacle), or +inf.
@@ -225,6 +234,8 @@ class LidarInertialSim {
   SE3 LocalPose(double t) const;
   // The nearest surface along a ray (normals only where realism needs them in the box room).
   RayHit Cast(const Vec3& o, const Vec3& d) const;
+  // Scan k of a non-repetitive pattern (sensor_scan.cc).
+  io::PointCloud PatternScan(size_t k) const;
   // IMU j's samples, biases and outages (IMU 0 draws from the single-IMU streams).
   void GenerateImu(size_t j);
   void ApplyImuOutages(size_t j);

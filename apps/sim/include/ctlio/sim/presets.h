@@ -40,6 +40,9 @@ struct SimOverrides {
   std::optional<double> accel_bias_walk;  // m/s²/√s
   std::optional<double> gyro_bias_walk;   // rad/s/√s
   std::optional<bool> newer_college_extrinsic;
+  // A sensor model (sensor_models.h) replacing the preset's lidar, IMU and extrinsic; the other
+  // overrides apply on top of it (`beams` only to a sensor without a datasheet beam table).
+  std::optional<std::string> sensor;
 };
 
 // The preset's regime, world and duration (kNone: fast, box, 20 s: the Table II simulator).
@@ -48,7 +51,7 @@ WorldKind PresetWorld(Preset preset);
 double PresetDuration(Preset preset);
 
 // Sequence `index` of the preset: ExperimentConfig(regime, index, seed, world) with the preset's
-// sensors, IMU, extrinsic and duration, then every given override applied.
+// sensors, IMU, extrinsic and duration, then the sensor model and every other given override.
 SimConfig PresetConfig(Preset preset, int index, uint64_t seed = kExperimentSeed,
                        const SimOverrides& overrides = {});
 

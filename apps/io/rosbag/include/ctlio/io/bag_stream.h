@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/io/livox_msgs.h"
 #include "ctlio/io/ros2_bag.h"
 
 namespace ctlio::io {
@@ -46,6 +47,7 @@ class BagStream {
   virtual void Read(const std::string& where, tf2_msgs::TFMessage* msg) = 0;
   virtual void Read(const std::string& where, nav_msgs::Odometry* msg) = 0;
   virtual void Read(const std::string& where, geometry_msgs::PoseStamped* msg) = 0;
+  virtual void Read(const std::string& where, livox::CustomMsg* msg) = 0;
 };
 
 // A ROS 1 bag file (checked by CheckBagStructure first). Throws naming `path`.

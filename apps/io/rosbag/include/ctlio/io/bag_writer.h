@@ -1,6 +1,7 @@
 // Writing any DataSource as a bag, ROS 1 (WriteRosbag, rosbag_source.h) or ROS 2 (WriteRos2Bag
 // below): one loop (WriteBagMessages) makes the messages — /tf_static, each IMU sample as
-// sensor_msgs/Imu, each scan as an Ouster-style PointCloud2, ground truth as nav_msgs/Odometry —
+// sensor_msgs/Imu, each scan as the options' lidar driver writes it (driver_conventions.h: an
+// Ouster-style PointCloud2 by default, or a Livox CustomMsg), ground truth as nav_msgs/Odometry —
 // and a sink stores them, in a ROS 1 bag through librosbag or in a ROS 2 bag as CDR
 // (cdr_messages.h) through a container writer (ros2_bag.h). The messages are written in receive
 // (log) time order, ground truth interleaved, so that a reader streaming the file meets them in
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "ctlio/io/livox_msgs.h"
 #include "ctlio/io/ros2_bag.h"
 #include "ctlio/io/rosbag_source.h"
 
@@ -27,6 +29,7 @@ class BagMessageSink {
   virtual void Write(const std::string& topic, int64_t log_ns,
                      const sensor_msgs::PointCloud2& m) = 0;
   virtual void Write(const std::string& topic, int64_t log_ns, const nav_msgs::Odometry& m) = 0;
+  virtual void Write(const std::string& topic, int64_t log_ns, const livox::CustomMsg& m) = 0;
 };
 
 // The messages of `source` into `sink` (the loop of WriteRosbag and WriteRos2Bag); the number of

@@ -6,11 +6,12 @@
 // bag of tens of GB is fine.
 //
 // Topics: --lidar_topic / --imu_topic; left empty, the only PointCloud2 and the only Imu topic of
-// the bag are used (several candidates: an error listing them). A dataset preset (Newer College
-// 2020/2021, chosen by name or recognised from its topic names) supplies topic names and the
-// extrinsic. Per-point times: point_fields.h (detected from the fields, overridable); a cloud
-// without a time field gets azimuth times (logged once). Ground truth: nav_msgs/Odometry or
-// geometry_msgs/PoseStamped on `ground_truth_topic`.
+// the bag are used (several candidates: an error listing them). A livox_ros_driver2/CustomMsg
+// topic is read as the lidar when named or when the bag has no PointCloud2 (livox_custom_msg.h). A
+// dataset preset (Newer College 2020/2021, chosen by name or recognised from its topic names)
+// supplies topic names and the extrinsic. Per-point times: point_fields.h (detected from the
+// fields, overridable); a cloud without a time field gets azimuth times (logged once). Ground
+// truth: nav_msgs/Odometry or geometry_msgs/PoseStamped on `ground_truth_topic`.
 //
 // Extrinsic T_imu_lidar, in this order (ImuFromLidar, ExtrinsicOrigin):
 //   1. (the caller's explicit config value, applied by the odometry runner, not here)
@@ -35,6 +36,7 @@
 
 #include "ctlio/io/bag_stream.h"
 #include "ctlio/io/dataset.h"
+#include "ctlio/io/driver_conventions.h"
 #include "ctlio/io/point_fields.h"
 
 namespace ctlio::io {
@@ -112,12 +114,28 @@ struct RosbagWriteOptions {
   bool write_tf_static = true;       // imu_frame → lidar_frame = source.ImuFromLidar()
   bool write_ground_truth = true;    // topic /ground_truth (nav_msgs/Odometry) if the source has it
   std::string compression = "none";  // chunk compression: none | lz4 | bz2 (read transparently)
+  // The lidar driver's cloud (driver_conventions.h): fields and per-point time (Velodyne's cloud
+  // is stamped at the scan end, the others at its start) or the Livox CustomMsg.
+  PointFormat point_format = PointFormat::kOuster;
+  double accel_unit = 1.0;  // the accelerometer is written in units of this many m/s² (g: 9.80665)
+  // A driver's format, topics, frames and accelerometer unit; no /tf_static when the lidar and
+  // the IMU share a frame (Livox: the extrinsic is the config's).
+  void UseDriver(const DriverConvention& d) {
+    point_format = d.format;
+    lidar_topic = d.lidar_topic;
+    imu_topic = d.imu_topic;
+    lidar_frame = d.lidar_frame;
+    imu_frame = d.imu_frame;
+    accel_unit = d.accel_unit;
+    write_tf_static = d.lidar_frame != d.imu_frame;
+  }
 };
 
-// Writes any data source as a bag: each scan as an Ouster-style PointCloud2 (OusterFields, `t` =
-// ns since the stamp = scan start), each IMU sample as sensor_msgs/Imu (orientation covariance
-// −1: no orientation), the extrinsic on /tf_static, ground truth on /ground_truth. Returns the
-// number of scans. `progress(done, total)` after each scan.
+// Writes any data source as a bag: each scan as the options' driver writes it (by default an
+// Ouster-style PointCloud2: OusterFields, `t` = ns since the stamp = scan start), each IMU sample
+// as sensor_msgs/Imu (orientation covariance −1: no orientation), the extrinsic on /tf_static,
+// ground truth on /ground_truth. Returns the number of scans. `progress(done, total)` after each
+// scan.
 size_t WriteRosbag(DataSource& source, const std::string& path,
                    const RosbagWriteOptions& options = {},
                    const std::function<void(size_t, size_t)>& progress = {});
