@@ -65,11 +65,13 @@ DEFINE_string(config, "",
               "(default: data/sim_lio.yaml of the source tree, data/newer_college_lio.yaml with "
               "--sim_preset newer_college)");
 DEFINE_string(regimes, "slow,medium,fast", "Comma-separated regimes (also walking, vehicle)");
-DEFINE_string(sim_preset, "",
-              "Recording preset: none | newer_college (sets world, regime, sensors, IMU, duration; "
-              "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
-              "win)");
-DEFINE_string(world, "box", "Simulated world: box | street | corridor | park | indoor");
+DEFINE_string(
+    sim_preset, "",
+    "Recording preset: none | newer_college | kitti (sets world, regime, sensors, IMU, duration; "
+    "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
+    "win)");
+DEFINE_string(world, "box",
+              "Simulated world: box | street | corridor | park | indoor | quad | town | office");
 DEFINE_string(methods, "singer_lio,imu_input,lidar_gyro,lidar_only", "Comma-separated methods");
 DEFINE_int32(sequences, 20, "Sequences per regime (the paper: 20)");
 DEFINE_int32(first_sequence, 0, "Index of the first sequence");
