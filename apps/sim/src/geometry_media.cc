@@ -25,6 +25,22 @@ uint64_t Bits(double v) {
 // Exponentially distributed depth with mean `free_path` (inverse transform of a uniform draw).
 double ExpDepth(double u, double free_path) { return -free_path * std::log1p(-u); }
 
+// Value noise in [−1, 1]: uniform values at the nodes of a square lattice (hashed from the
+// seed), blended with the C¹ smoothstep. Cheaper than waves and without a period.
+double ValueNoise(uint64_t seed, double x, double y, double lattice) {
+  const double a = x / lattice, b = y / lattice;
+  const double fa = std::floor(a), fb = std::floor(b);
+  const int64_t i = int64_t(fa), j = int64_t(fb);
+  auto node = [&](int64_t di, int64_t dj) {
+    const uint64_t h = SplitMix(SplitMix(seed ^ uint64_t(i + di)) ^ uint64_t(j + dj));
+    return 2.0 * double(h >> 11) * 0x1.0p-53 - 1.0;
+  };
+  const double u = a - fa, v = b - fb;
+  const double su = u * u * (3 - 2 * u), sv = v * v * (3 - 2 * v);
+  return (node(0, 0) * (1 - su) + node(1, 0) * su) * (1 - sv) +
+         (node(0, 1) * (1 - su) + node(1, 1) * su) * sv;
+}
+
 }  // namespace
 
 double RayUniform(uint64_t seed, const Vec3& o, const Vec3& d, uint64_t salt) {
@@ -67,23 +83,7 @@ RayHit Scene::IntersectMedium(uint32_t index, const Vec3& o, const Vec3& d, cons
 }
 
 double Scene::Relief(double x, double y) const {
-  if (relief == 0.0) return 0.0;
-  // Value noise: uniform heights in [−1, 1] at the nodes of a 0.6 m lattice (hashed from the
-  // seed), blended with the C¹ smoothstep; then scaled by the amplitude. Cheaper than waves and
-  // without a period.
-  constexpr double kLattice = 0.6;
-  const double a = x / kLattice, b = y / kLattice;
-  const double fa = std::floor(a), fb = std::floor(b);
-  const int64_t i = int64_t(fa), j = int64_t(fb);
-  auto node = [&](int64_t di, int64_t dj) {
-    const uint64_t h = SplitMix(SplitMix(seed ^ 0x5E11EFULL ^ uint64_t(i + di)) ^ uint64_t(j + dj));
-    return 2.0 * double(h >> 11) * 0x1.0p-53 - 1.0;
-  };
-  const double u = a - fa, v = b - fb;
-  const double su = u * u * (3 - 2 * u), sv = v * v * (3 - 2 * v);
-  const double z = (node(0, 0) * (1 - su) + node(1, 0) * su) * (1 - sv) +
-                   (node(0, 1) * (1 - su) + node(1, 1) * su) * sv;
-  return relief * z;
+  return relief == 0.0 ? 0.0 : relief * ValueNoise(seed ^ 0x5E11EFULL, x, y, 0.6);
 }
 
 RayHit Scene::CastGround(const Vec3& o, const Vec3& d, double t_max) const {
@@ -101,19 +101,29 @@ RayHit Scene::CastGround(const Vec3& o, const Vec3& d, double t_max) const {
   if (!g.Valid() || d.z() >= -1e-6) return g.t < t_max ? g : RayHit{};
   const Vec3 p = o + g.t * d;
   const double dz = -d.z();
-  // A surface raised by δz is met δz/|d_z| earlier along the ray (clamped at grazing rays).
-  double t = g.t - std::clamp(Relief(p.x(), p.y()) / dz, -0.5, 0.5);
+  const GroundCover* cover = nullptr;
   for (const GroundCover& c : covers) {
-    if (p.x() < c.x0 || p.x() > c.x1 || p.y() < c.y0 || p.y() > c.y1) continue;
+    if (p.x() >= c.x0 && p.x() <= c.x1 && p.y() >= c.y0 && p.y() <= c.y1) {
+      cover = &c;
+      break;
+    }
+  }
+  // A surface raised by δz is met δz/|d_z| earlier along the ray (clamped at grazing rays);
+  // under a cover the ground has its tussocks too (a finer lattice).
+  const double dzr = Relief(p.x(), p.y());
+  double t = g.t - std::clamp(dzr / dz, -0.5, 0.5);
+  if (cover != nullptr) {
+    const GroundCover& c = *cover;
+    const double tussock =
+        c.relief != 0.0 ? c.relief * ValueNoise(seed ^ 0x7A55ULL, p.x(), p.y(), 0.25) : 0.0;
+    double tc = g.t - std::clamp((dzr + tussock) / dz, -0.5, 0.5);
     const double chord = c.height / dz;
     const double s = ExpDepth(RayUniform(seed, o, d, 0x6AA55ULL), c.free_path);
-    // The return lies in the layer over the cover (at its edge, a ray entering the layer
-    // outside the rectangle reaches the ground).
-    const Vec3 q = o + (t - chord + s) * d;
-    if (s < chord && q.x() >= c.x0 && q.x() <= c.x1 && q.y() >= c.y0 && q.y() <= c.y1) {
-      t -= chord - s;
-    }
-    break;
+    if (s < chord) tc -= chord - s;
+    // The return lies over the cover (at its edge, a ray entering the layer outside the
+    // rectangle reaches the bare ground).
+    const Vec3 q = o + tc * d;
+    if (q.x() >= c.x0 && q.x() <= c.x1 && q.y() >= c.y0 && q.y() <= c.y1) t = tc;
   }
   if (!(t > 0.0)) t = g.t;
   g.t = t;
@@ -127,15 +137,15 @@ bool Scene::InMedium(const Vec3& p) const {
   }
   // Within the relief (and the cover above it) of a floor or a height field.
   auto near_ground = [&](double ground) {
-    double top = ground + std::abs(relief) + 1e-6;
+    double below = std::abs(relief) + 1e-6, above = below;
     for (const GroundCover& c : covers) {
       if (p.x() >= c.x0 && p.x() <= c.x1 && p.y() >= c.y0 && p.y() <= c.y1) {
-        top += c.height;
+        above += c.height + std::abs(c.relief);
+        below += std::abs(c.relief);
         break;
       }
     }
-    return (relief != 0.0 || !covers.empty()) && p.z() >= ground - std::abs(relief) - 1e-6 &&
-           p.z() <= top;
+    return (relief != 0.0 || !covers.empty()) && p.z() >= ground - below && p.z() <= ground + above;
   };
   for (const double z : floors)
     if (near_ground(z)) return true;

@@ -71,6 +71,10 @@ void AddFacade(Scene& s, std::mt19937_64& rng, const Facade& F, double L, int st
       AddBox(s, F.At(u, 0, z0), F.At(u0, r, z1));  // pier
       if (zb > z0) AddBox(s, F.At(u0, 0, z0), F.At(u1, r, zb));
       AddBox(s, F.At(u0, 0, std::min(zt, z1)), F.At(u1, r, z1));
+      if (!door && !balcony) {  // a mullion in the middle of the opening
+        const double um = 0.5 * (u0 + u1);
+        AddBox(s, F.At(um - 0.05, 0.3 * r, zb), F.At(um + 0.05, r, zt));
+      }
       if (glass && !door) {
         s.glass.push_back(Box::Spanning(F.At(u0, 0.4 * r, zb), F.At(u1, 0.5 * r, zt)));
       }

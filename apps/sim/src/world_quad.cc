@@ -15,15 +15,16 @@ World BuildQuadWorld(const QuadParams& p, uint64_t seed) {
   Scene& s = world.scene;
   s.seed = seed;
   s.floors = {0.0};
-  const VegetationParams& veg = p.vegetation;
+  VegetationParams veg = p.vegetation;
   s.relief = veg.relief;
   const double Lx = p.lawn_x, Ly = p.lawn_y, w = p.walkway;
   const double yc = 0.5 * Ly;  // the arch's axis
   const double D = U(p.depth.lo, p.depth.hi);
   const double park_x0 = Lx + w + D + p.park_gap, park_x1 = park_x0 + p.park;
   const double park_y0 = yc - 0.5 * p.park, park_y1 = yc + 0.5 * p.park;
-  s.covers.push_back({0.0, 0.0, Lx, Ly, veg.grass_height, veg.grass_free_path});
-  s.covers.push_back({park_x0, park_y0, park_x1, park_y1, veg.grass_height, veg.grass_free_path});
+  s.covers.push_back({0.0, 0.0, Lx, Ly, veg.grass_height, veg.grass_free_path, veg.grass_relief});
+  s.covers.push_back({park_x0, park_y0, park_x1, park_y1, veg.grass_height, veg.grass_free_path,
+                      veg.grass_relief});
 
   // The path: round the quad 2 m from the façades, through the arch, round the park and back.
   const double xe = Lx + w - 2.0, x1 = park_x0 + 10.0, x2 = park_x1 - 10.0;

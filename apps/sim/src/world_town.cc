@@ -48,7 +48,7 @@ World BuildTownWorld(const TownParams& p, uint64_t seed) {
         st.window_width = U(0.9, 1.6);
         st.pier = U(0.8, 2.0);
         st.recess = U(0.15, 0.3);
-        st.glass_fraction = U(0.3, 0.7);
+        st.glass_fraction = U(0.5, 0.9);
         st.balcony_probability = U(0, 0.25);
         st.ledge_probability = U(0, 0.6);
         st.cornice = U(0, 1) < 0.5;
@@ -58,28 +58,37 @@ World BuildTownWorld(const TownParams& p, uint64_t seed) {
         if (garden > 1.5) {
           const Vec3 g0 = at(a, rh + pav, 0), g1 = at(a + width, f0, 0);
           const Vec3 lo = g0.cwiseMin(g1), hi = g0.cwiseMax(g1);
-          s.covers.push_back(
-              {lo.x(), lo.y(), hi.x(), hi.y(), veg.grass_height, veg.grass_free_path});
+          s.covers.push_back({lo.x(), lo.y(), hi.x(), hi.y(), veg.grass_height, veg.grass_free_path,
+                              veg.grass_relief});
           if (U(0, 1) < p.hedge_probability) {
             content::AddHedge(s, at(a + 0.3, rh + pav + 0.1, 0),
-                              at(a + width - 0.3, rh + pav + U(0.6, 1.2), 0), U(0.9, 1.9),
+                              at(a + width - 0.3, rh + pav + U(0.6, 1.2), 0), U(1.1, 2.2),
                               veg.hedge_free_path);
           }
-          for (int k = int(U(0, 3)); k > 0; --k) {
+          for (int k = 1 + int(U(0, 4)); k > 0; --k) {
             content::AddBush(s, rng, at(a + U(1, width - 1), rh + pav + 0.5 * garden + 0.4, 0),
-                             std::min(U(0.5, 1.3), 0.4 * garden), veg.bush_free_path);
+                             std::min(U(0.6, 1.6), 0.45 * garden), veg.bush_free_path);
           }
-          if (garden > 4.0 && U(0, 1) < 0.5) {
+          if (garden > 3.0 && U(0, 1) < 0.8) {
             content::AddTree(s, rng, at(a + U(2, width - 2), rh + pav + 0.5 * garden, 0),
                              U(0.5, 0.9), veg.crown_free_path);
           }
         }
-        a += width + R(p.gap);
+        const double gap = R(p.gap);
+        if (gap > 3.0) {  // a side garden: a tree or a large bush between the houses
+          const Vec3 base = at(a + width + 0.5 * gap, f0 + U(1, depth), 0);
+          if (U(0, 1) < 0.5) {
+            content::AddTree(s, rng, base, U(0.4, 0.8), veg.crown_free_path);
+          } else {
+            content::AddBush(s, rng, base, 0.45 * gap, veg.bush_free_path);
+          }
+        }
+        a += width + gap;
       }
       // Street trees at the kerb, parked cars, poles, people.
       for (double a = a_lo + 0.5 * R(p.street_tree_spacing); a < a_hi;
            a += R(p.street_tree_spacing)) {
-        content::AddTree(s, rng, at(a, rh + 0.8, 0.12), U(0.6, 1.1), veg.crown_free_path);
+        content::AddTree(s, rng, at(a, rh + 0.8, 0.12), U(0.8, 1.3), veg.crown_free_path);
       }
       for (double a = a_lo; a + 6.0 < a_hi; a += 6.0) {
         if (U(0, 1) >= p.car_probability) continue;

@@ -92,6 +92,7 @@ struct GroundCover {
   double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
   double height = 0.1;      // layer thickness [m]
   double free_path = 0.05;  // mean depth of a return inside, along the ray [m]
+  double relief = 0.0;      // extra micro-relief under the cover (tussocks, 0.25 m lattice) [m]
 };
 
 // Uniform in [0, 1) from the ray (origin and direction bits), the scene seed and a salt.

@@ -94,11 +94,12 @@ struct IndoorParams {
 // Free paths are the mean depth of a return inside a medium.
 struct VegetationParams {
   double crown_free_path = 0.8;  // tree crowns [m]
-  double bush_free_path = 0.35;
-  double hedge_free_path = 0.2;
+  double bush_free_path = 0.5;
+  double hedge_free_path = 0.35;
   double grass_height = 0.1;      // [m]
   double grass_free_path = 0.08;  // [m]
-  double relief = 0.03;           // ground micro-relief amplitude [m]
+  double relief = 0.03;           // ground micro-relief amplitude [m] (0.6 m lattice)
+  double grass_relief = 0.04;     // extra relief under grass [m] (tussocks, 0.25 m lattice)
 };
 
 // College quad (Newer College-like): a lawn of lawn_x × lawn_y inside a ring of stone buildings
@@ -112,7 +113,7 @@ struct QuadParams {
   double storey = 3.6;
   double arch_width = 5.0, arch_height = 4.2;
   double park = 90.0, park_gap = 6.0;  // park side; distance east of the east range
-  double park_trees_per_hectare = 45.0, park_bushes_per_hectare = 40.0;
+  double park_trees_per_hectare = 30.0, park_bushes_per_hectare = 20.0;
   int quad_trees = 4, people = 8, benches = 6;
   VegetationParams vegetation;
 };
@@ -124,12 +125,12 @@ struct QuadParams {
 struct TownParams {
   double length = 300.0, width = 110.0;
   double road_half_width = 5.5, pavement = 3.0, lane_offset = 1.8;
-  double corner_radius = 10.0, corner_clear = 16.0;
+  double corner_radius = 10.0, corner_clear = 9.5;
   Range garden{2, 9};  // pavement → façade [m]
   Range house_width{9, 20}, house_depth{9, 14}, gap{1, 7};
   int min_storeys = 2, max_storeys = 5;
-  double hedge_probability = 0.6;    // per house: a hedge along the pavement
-  Range street_tree_spacing{7, 14};  // at the kerb [m]
+  double hedge_probability = 0.85;   // per house: a hedge along the pavement
+  Range street_tree_spacing{5, 10};  // at the kerb [m]
   double car_probability = 0.65;     // per 6 m kerb slot
   Range pole_spacing{18, 30};
   double people_per_100m = 3.0;
