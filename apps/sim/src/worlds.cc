@@ -227,8 +227,12 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
     return hi.x() > view.min.x() && lo.x() < view.max.x() && hi.y() > view.min.y() &&
            lo.y() < view.max.y();
   };
+  // Worlds of thousands of façade parts: the small ones (piers, bands, < 1 m² from above) are
+  // left out, the building bodies show.
+  const bool detailed = boxes.size() > 2000;
   for (const Box& b : boxes) {
     if (!visible(b.min, b.max)) continue;
+    if (detailed && (b.max.x() - b.min.x()) * (b.max.y() - b.min.y()) < 1.0) continue;
     const int g = std::clamp(int(200 - 4 * b.max.z()), 60, 200);
     out << "<rect x='" << X(b.min.x()) << "' y='" << Y(b.max.y()) << "' width='"
         << (b.max.x() - b.min.x()) * px << "' height='" << (b.max.y() - b.min.y()) * px
@@ -236,7 +240,7 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
         << ")' fill-opacity='0.6' stroke='#333' stroke-width='0.3'/>\n";
   }
   for (const Box& b : s.glass) {
-    if (!visible(b.min, b.max)) continue;
+    if (!visible(b.min, b.max) || detailed) continue;
     out << "<rect x='" << X(b.min.x()) << "' y='" << Y(b.max.y()) << "' width='"
         << std::max((b.max.x() - b.min.x()) * px, 0.8) << "' height='"
         << std::max((b.max.y() - b.min.y()) * px, 0.8) << "' fill='#3080e0'/>\n";
