@@ -61,18 +61,21 @@ int main(int argc, char** argv) {
     options.max_range = FLAGS_max_range;
     options.voxel = FLAGS_voxel;
     options.neighbours = FLAGS_neighbours;
-    eval::WriteGeometryHeader(std::cout);
     if (!FLAGS_cloud.empty()) {
+      bool header = false;
       for (const std::string& path : apps::SplitList(FLAGS_cloud)) {
         const std::string ext = std::filesystem::path(path).extension().string();
         const io::PointCloud cloud =
             ext == ".bin" ? io::ReadKittiBin(path, FLAGS_bin_floats) : io::ReadPointCloud(path);
+        if (!header) eval::WriteGeometryHeader(std::cout);
+        header = true;
         eval::WriteGeometryRow(std::cout, std::filesystem::path(path).filename().string(),
                                eval::ComputeGeometryStatistics(cloud.points, options));
       }
       return 0;
     }
     const auto source = io::OpenDataset(FLAGS_dataset);
+    eval::WriteGeometryHeader(std::cout);
     io::ScanFrame frame;
     int reported = 0;
     for (size_t k = 0; reported < FLAGS_scans && source->Next(&frame); ++k) {

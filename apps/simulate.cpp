@@ -319,6 +319,10 @@ int main(int argc, char** argv) {
     if (!FLAGS_geometry_report.empty()) {
       eval::WriteGeometryHeader(std::cout);
       for (const std::string& item : apps::SplitList(FLAGS_geometry_report)) {
+        if (item.find_first_not_of("0123456789") != std::string::npos || item.size() > 9) {
+          throw std::runtime_error("--geometry_report='" + FLAGS_geometry_report +
+                                   "': expected scan indices, e.g. 0,50");
+        }
         const size_t k = std::stoul(item);
         if (k >= source.NumScans()) {
           throw std::runtime_error("--geometry_report: scan " + item + " is not in the " +
