@@ -136,6 +136,23 @@ TEST(WorldContent, GlassStopsRaysWithoutAReturnAndCoverAndReliefStayNearTheGroun
   EXPECT_GT(hi - lo, 0.02);               // the relief is not flat
 }
 
+// A walking person is where their lane puts them at the time of the ray, and nowhere else.
+TEST(WorldContent, MovingPeopleAreWhereTheirLaneSaysAtTheTimeOfTheRay) {
+  Scene s;
+  s.floors = {0.0};
+  s.movers.push_back({Vec3(10, -5, 0), Vec3(10, 5, 0), 1.0, 0.0, 0.25, 1.8});
+  s.Build(2.0);
+  EXPECT_TRUE(s.movers[0].At(5.0).isApprox(Vec3(10, 0, 0)));
+  EXPECT_TRUE(s.movers[0].At(15.0).isApprox(Vec3(10, 0, 0)));  // back again after the far end
+  EXPECT_TRUE(s.movers[0].At(12.0).isApprox(Vec3(10, 3, 0)));
+  const Vec3 o(0, 0, 1), d(1, 0, 0);
+  EXPECT_NEAR(s.Cast(o, d, 100, 5.0).t, 9.75, 1e-9);  // in the ray's way at 5 s
+  EXPECT_FALSE(s.Cast(o, d, 100, 8.0).Valid());       // 3 m aside at 8 s
+  EXPECT_FALSE(s.Cast(o, d, 100).Valid());            // the static scene has no people
+  EXPECT_TRUE(s.OnMover(Vec3(9.75, 0, 1), 5.0));
+  EXPECT_FALSE(s.OnMover(Vec3(9.75, 0, 1), 8.0));
+}
+
 // The statistic of the documented comparison (docs/experiments/worlds-geometry.md) on fixed
 // seeds: the quad's sweeps near real Newer College's (planar 0.49 / 0.60, scattered 0.10), the
 // town's near real KITTI 07's (0.38, 0.31) within the issue's ±0.1 (the town's planar fraction

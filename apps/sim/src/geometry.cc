@@ -252,6 +252,11 @@ void Scene::Build(double cell) {
                 media[r.index].centre + media[r.index].radii};
       case kGlass:
         return glass[r.index];
+      case kMover: {  // the lane it walks
+        const Mover& m = movers[r.index];
+        const Vec3 e(m.radius, m.radius, 0.0);
+        return {m.a.cwiseMin(m.b) - e, m.a.cwiseMax(m.b) + e + Vec3(0, 0, m.height)};
+      }
       default: {
         const Sphere& s = spheres[r.index];
         return {s.centre - Vec3::Constant(s.radius), s.centre + Vec3::Constant(s.radius)};
@@ -264,6 +269,7 @@ void Scene::Build(double cell) {
   for (uint32_t i = 0; i < spheres.size(); ++i) all.push_back({kSphere, i});
   for (uint32_t i = 0; i < media.size(); ++i) all.push_back({kMedium, i});
   for (uint32_t i = 0; i < glass.size(); ++i) all.push_back({kGlass, i});
+  for (uint32_t i = 0; i < movers.size(); ++i) all.push_back({kMover, i});
   refs_.clear();
   large_.clear();
   cell_start_.assign(1, 0);
@@ -325,7 +331,7 @@ void Scene::Build(double cell) {
 }
 
 RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
-                           double t_max) const {
+                           double t_max, double time) const {
   switch (r.kind) {
     case kBox:
       return IntersectBox(boxes[r.index], o, d, inv_d, t_max);
@@ -335,12 +341,25 @@ RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec
       return IntersectMedium(r.index, o, d, inv_d, t_max);
     case kGlass:
       return IntersectBox(glass[r.index], o, d, inv_d, t_max);
+    case kMover: {
+      if (std::isnan(time)) return {};
+      const Mover& m = movers[r.index];
+      return IntersectCylinder({m.At(time), m.radius, m.height}, o, d, t_max);
+    }
     default:
       return IntersectSphere(spheres[r.index], o, d, t_max);
   }
 }
 
 RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
+  return CastAt(o, d, t_max, std::numeric_limits<double>::quiet_NaN());
+}
+
+RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max, double time) const {
+  return CastAt(o, d, t_max, time);
+}
+
+RayHit Scene::CastAt(const Vec3& o, const Vec3& d, double t_max, double time) const {
   RayHit best;
   bool best_glass = false;  // the nearest hit stops the ray without a return
   auto keep = [&](const RayHit& h, bool is_glass = false) {
@@ -365,7 +384,7 @@ RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
     keep(CastGround(o, d, t_max));
   }
   const Vec3 inv_d = d.cwiseInverse();
-  for (const Ref& r : large_) keep(IntersectRef(r, o, d, inv_d, best.t), r.kind == kGlass);
+  for (const Ref& r : large_) keep(IntersectRef(r, o, d, inv_d, best.t, time), r.kind == kGlass);
   if (refs_.empty()) return best_glass ? RayHit{} : best;
   double t0 = 0.0, t1 = std::min(t_max, best.t);
   ClipXY(o, d, bounds_.min.x(), bounds_.min.y(), bounds_.max.x(), bounds_.max.y(), &t0, &t1);
@@ -381,7 +400,7 @@ RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
                  for (uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
                    const Ref& r = refs_[k];
                    if (r.zlo > hi || r.zhi < lo) continue;
-                   keep(IntersectRef(r, o, d, inv_d, best.t), r.kind == kGlass);
+                   keep(IntersectRef(r, o, d, inv_d, best.t, time), r.kind == kGlass);
                  }
                  return best.t <= tb;
                });

@@ -130,6 +130,23 @@ RayHit Scene::CastGround(const Vec3& o, const Vec3& d, double t_max) const {
   return g.t < t_max ? g : RayHit{};
 }
 
+Vec3 Mover::At(double time) const {
+  const double L = (b - a).norm();
+  if (L <= 0.0) return a;
+  const double s = std::fmod(std::max(speed * time + phase, 0.0), 2 * L);
+  return a + (std::min(s, 2 * L - s) / L) * (b - a);
+}
+
+bool Scene::OnMover(const Vec3& p, double time) const {
+  for (const Mover& m : movers) {
+    const Vec3 base = m.At(time);
+    if ((p - base).head<2>().norm() <= m.radius + 1e-3 && p.z() >= base.z() - 1e-3 &&
+        p.z() <= base.z() + m.height + 1e-3)
+      return true;
+  }
+  return false;
+}
+
 bool Scene::InMedium(const Vec3& p) const {
   for (const Medium& m : media) {
     const Vec3 e = (p - m.centre).cwiseQuotient(m.radii);

@@ -102,6 +102,23 @@ World BuildQuadWorld(const QuadParams& p, uint64_t seed) {
     const double x = U(x1 + 2.5, x2 - 2.5), y = U(0, 1) < 0.5 ? ys + 2.2 : yn - 2.2;
     content::AddBench(s, Vec3(x, y, 0), true);
   }
+  // Walking people (drawn last: the static world is the same with or without them): on the
+  // lawn, and in the park on lanes clear of the path.
+  auto clear_lane = [&](const Vec3& a, const Vec3& b) {
+    for (int k = 0; k <= 10; ++k) {
+      const Vec3 q = a + 0.1 * k * (b - a);
+      if (!clear_of_path(q.x(), q.y(), 2.5)) return false;
+    }
+    return true;
+  };
+  for (int k = 0; k < p.walkers; ++k) {
+    const bool lawn = k < p.walkers / 2;
+    const double x0 = lawn ? 4 : park_x0 + 5, x1 = lawn ? Lx - 4 : park_x1 - 5;
+    const double y0 = lawn ? 4 : park_y0 + 5, y1 = lawn ? Ly - 4 : park_y1 - 5;
+    const Vec3 a(U(x0, x1), U(y0, y1), 0), b(U(x0, x1), U(y0, y1), 0);
+    const double speed = U(0.9, 1.6), phase = U(0, 100);
+    if (clear_lane(a, b)) s.movers.push_back({a, b, speed, phase, 0.22, U(1.6, 1.85)});
+  }
   s.Build(4.0);
   world.start_range = world.path.Length();
   world.max_speed = 2.5;

@@ -104,6 +104,20 @@ World BuildTownWorld(const TownParams& p, uint64_t seed) {
       }
     }
   }
+  // People walking along the pavements (drawn last: the static world is the same without them).
+  for (int side = 0; side < 4; ++side) {
+    const Vec3 A = road[side], B = road[(side + 1) % 4];
+    const double len = (B - A).norm();
+    const Vec3 u = (B - A) / len, out(u.y(), -u.x(), 0.0);
+    for (const double sign : {1.0, -1.0}) {
+      const int n = int(std::lround(p.walkers_per_100m * (len - 2 * p.corner_clear) / 100.0));
+      for (int k = 0; k < n; ++k) {
+        const double a0 = U(p.corner_clear, len - p.corner_clear - 25.0), lane = U(1.0, pav - 0.8);
+        const Vec3 a = A + a0 * u + sign * (rh + lane) * out + Vec3(0, 0, 0.12);
+        s.movers.push_back({a, a + U(10, 25) * u, U(0.9, 1.6), U(0, 100), 0.22, U(1.6, 1.85)});
+      }
+    }
+  }
   s.Build(4.0);
   const double o = p.lane_offset;
   w.path = Path({Vec3(-o, -o, 0), Vec3(p.length + o, -o, 0), Vec3(p.length + o, p.width + o, 0),

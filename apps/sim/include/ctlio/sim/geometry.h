@@ -17,7 +17,9 @@
 //     height fields) that is such a medium;
 //   * micro-relief: the ground's hits are raised by δz(x, y), a smooth field of amplitude
 //     `relief` (value noise on a 0.6 m lattice), along the ray: t' = t − δz/|d_z| (clamped);
-//   * glass: boxes that stop a ray without a return (windows; the ray gives no point).
+//   * glass: boxes that stop a ray without a return (windows; the ray gives no point);
+//   * moving people: upright cylinders (body) walking back and forth between two points at a
+//     constant speed, placed by the time of the ray (Cast with a time).
 // The random depth is a pure function of (scene seed, the ray's origin and direction bits, the
 // medium): the same ray always gets the same return, so a scan is still a pure function of the
 // seeds and the scan index. A scene without these gives exactly the hits it gave before.
@@ -95,6 +97,15 @@ struct GroundCover {
   double relief = 0.0;      // extra micro-relief under the cover (tussocks, 0.25 m lattice) [m]
 };
 
+// A person walking back and forth along a → b (ground points) at `speed`: at time τ the arc
+// length s = (speed·τ + phase) mod 2L (L = |b − a|) puts them at a + min(s, 2L − s)/L·(b − a).
+struct Mover {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  double speed = 1.3, phase = 0.0;  // m/s, m
+  double radius = 0.22, height = 1.75;
+  Vec3 At(double time) const;  // the ground point under the person
+};
+
 // Uniform in [0, 1) from the ray (origin and direction bits), the scene seed and a salt.
 double RayUniform(uint64_t seed, const Vec3& o, const Vec3& d, uint64_t salt);
 
@@ -110,12 +121,17 @@ class Scene {
   std::vector<Medium> media;
   std::vector<GroundCover> covers;
   std::vector<Box> glass;
-  double relief = 0.0;  // micro-relief amplitude of the ground [m]
-  uint64_t seed = 0;    // of the per-ray draws in media and ground cover
+  std::vector<Mover> movers;  // not in Occupied(): the guide paths keep clear of their lanes
+  double relief = 0.0;        // micro-relief amplitude of the ground [m]
+  uint64_t seed = 0;          // of the per-ray draws in media and ground cover
 
   // Bins the finite primitives into square xy cells of `cell` metres.
   void Build(double cell);
   RayHit Cast(const Vec3& o, const Vec3& d, double t_max) const;
+  // The same with the moving people at `time`.
+  RayHit Cast(const Vec3& o, const Vec3& d, double t_max, double time) const;
+  // True when p lies on or in a moving person at `time` (within 1 mm).
+  bool OnMover(const Vec3& p, double time) const;
   // True when p lies inside a solid (or below the ground / a height field).
   bool Occupied(const Vec3& p) const;
   // True when p lies in a scattering medium, in the ground cover or within the relief of the
@@ -127,7 +143,7 @@ class Scene {
   Box Bounds() const { return bounds_; }
 
  private:
-  enum Kind : uint32_t { kBox = 0, kCylinder = 1, kSphere = 2, kMedium = 3, kGlass = 4 };
+  enum Kind : uint32_t { kBox, kCylinder, kSphere, kMedium, kGlass, kMover };
   struct Ref {
     uint32_t kind, index;
     double zlo = 0.0, zhi = 0.0;  // the primitive's vertical extent (culling along the ray)
@@ -139,8 +155,10 @@ class Scene {
   std::vector<double> cell_top_;      // highest point of the refs of cell c
   std::vector<Ref> refs_;
   std::vector<Ref> large_;  // tested once per ray, not binned
-  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
-                      double t_max) const;
+  // `time` NaN: the static scene (movers are skipped).
+  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d, double t_max,
+                      double time) const;
+  RayHit CastAt(const Vec3& o, const Vec3& d, double t_max, double time) const;
   RayHit IntersectMedium(uint32_t index, const Vec3& o, const Vec3& d, const Vec3& inv_d,
                          double t_max) const;
   // The ground hit (floors, height fields) with relief and cover applied.

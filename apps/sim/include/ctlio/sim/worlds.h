@@ -90,7 +90,8 @@ struct IndoorParams {
 // The realistic worlds (docs/user-guide/simulator.md, "Realistic content"; built from
 // src/world_content.h): façades with windows (recesses, glass returning nothing), ledges,
 // balconies and doors; trees and bushes whose crowns are scattering media; hedges; grass as a
-// scattering layer over a ground with micro-relief; parked cars, poles, people, benches; furniture.
+// scattering layer over a ground with micro-relief; parked cars, poles, people (standing, and
+// walking back and forth on lanes clear of the path), benches; furniture.
 // Free paths are the mean depth of a return inside a medium.
 struct VegetationParams {
   double crown_free_path = 0.8;  // tree crowns [m]
@@ -115,6 +116,7 @@ struct QuadParams {
   double park = 90.0, park_gap = 6.0;  // park side; distance east of the east range
   double park_trees_per_hectare = 30.0, park_bushes_per_hectare = 20.0;
   int quad_trees = 4, people = 8, benches = 6;
+  int walkers = 8;  // moving people: half on the lawn, half in the park
   VegetationParams vegetation;
 };
 
@@ -134,6 +136,7 @@ struct TownParams {
   double car_probability = 0.65;     // per 6 m kerb slot
   Range pole_spacing{18, 30};
   double people_per_100m = 3.0;
+  double walkers_per_100m = 1.0;  // moving people, per side of a street
   VegetationParams vegetation;
 };
 
