@@ -70,11 +70,13 @@ DEFINE_string(sim_sensor, "",
               "Sensor model os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | pandar_xt32 | mid360 | "
               "avia (ctlio_simulate --sensor list; sets lidar, IMU and extrinsic; default config "
               "data/sensors/<sensor>.yaml)");
-DEFINE_string(sim_preset, "",
-              "Recording preset: none | newer_college (sets world, regime, sensors, IMU, duration; "
-              "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
-              "win)");
-DEFINE_string(world, "box", "Simulated world: box | street | corridor | park | indoor");
+DEFINE_string(
+    sim_preset, "",
+    "Recording preset: none | newer_college | kitti (sets world, regime, sensors, IMU, duration; "
+    "explicit --world/--regimes/--duration/--beams/--firing_decimation/--body_centric "
+    "win)");
+DEFINE_string(world, "box",
+              "Simulated world: box | street | corridor | park | indoor | quad | town | office");
 DEFINE_string(methods, "singer_lio,imu_input,lidar_gyro,lidar_only", "Comma-separated methods");
 DEFINE_int32(sequences, 20, "Sequences per regime (the paper: 20)");
 DEFINE_int32(first_sequence, 0, "Index of the first sequence");

@@ -126,10 +126,10 @@ DEFINE_int32(frontend_threads, 1,
 DEFINE_string(association, "",
               "Override lidar_frontend.association of the config: knn | voxel_plane");
 DEFINE_string(sim_preset, "",
-              "--format sim: recording preset none | newer_college (explicit --sim_* flags win)");
+              "--format sim: preset none | newer_college | kitti (explicit --sim_* flags win)");
 DEFINE_string(sim_sensor, "", "--format sim: sensor model (ctlio_simulate --sensor list)");
 DEFINE_string(sim_regime, "fast", "--format sim: slow | medium | fast | walking | vehicle");
-DEFINE_string(sim_world, "box", "--format sim: box | street | corridor | park | indoor");
+DEFINE_string(sim_world, "box", "--format sim: box|street|corridor|park|indoor|quad|town|office");
 DEFINE_int32(sim_index, 0, "--format sim: sequence index within the regime");
 DEFINE_double(sim_duration, 20.0, "--format sim: sequence length [s]");
 DEFINE_int32(sim_firing_decimation, 1,

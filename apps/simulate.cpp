@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -29,6 +30,7 @@
 
 #include "common/command_line.h"
 #include "common/preset_flags.h"
+#include "ctlio/eval/geometry_statistics.h"
 #include "ctlio/io/bag_writer.h"
 #include "ctlio/io/checked_output.h"
 #include "ctlio/io/newer_college.h"
@@ -42,7 +44,8 @@
 #include "ctlio/sim/sensor_models.h"
 
 DEFINE_string(output, "", "Dataset folder to write (required)");
-DEFINE_string(preset, "", "Recording preset: none | newer_college (explicit flags override it)");
+DEFINE_string(preset, "",
+              "Recording preset: none | newer_college | kitti (explicit flags override it)");
 DEFINE_string(sensor, "",
               "Sensor model: os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | pandar_xt32 | mid360 | "
               "avia (lidar, IMU, extrinsic and, in bags, the driver's fields, topics and frames; "
@@ -57,8 +60,13 @@ DEFINE_string(bag_compression, "none",
               "--layout rosbag: chunk compression none | lz4 | bz2; --layout ros2: none | zstd | "
               "lz4");
 DEFINE_string(regime, "fast", "Motion regime: slow | medium | fast | walking | vehicle");
-DEFINE_string(world, "box", "World: box | street | corridor | park | indoor");
+DEFINE_string(world, "box",
+              "World: box | street | corridor | park | indoor | quad | town | office");
 DEFINE_uint64(world_seed, ctlio::sim::kExperimentSeed, "Seed of the world's geometry");
+DEFINE_string(geometry_report, "",
+              "Scan indices, comma separated (e.g. 0,50): print the local-geometry statistic of "
+              "these sweeps (ctlio_geometry_report's table) and the time to simulate each, and "
+              "write nothing (--output not needed)");
 DEFINE_string(topview, "", "Also write a top view of the world and its path (SVG) to this file");
 DEFINE_double(range_noise_per_m, 0.0,
               "Range noise growing with range: σ = 0.02 m + k·r, k [m/m]; 0 = constant 2 cm");
@@ -181,7 +189,8 @@ ctlio::io::RosbagWriteOptions BagWriteOptions() {
   o.write_ground_truth = FLAGS_ground_truth;
   if (!FLAGS_sensor.empty()) {
     ctlio::io::DriverConvention d = ctlio::sim::FindSensorModel(FLAGS_sensor).driver;
-    if (d.format == ctlio::io::PointFormat::kLivoxCustomMsg && FLAGS_livox_format == "pointcloud2") {
+    if (d.format == ctlio::io::PointFormat::kLivoxCustomMsg &&
+        FLAGS_livox_format == "pointcloud2") {
       d.format = ctlio::io::PointFormat::kLivoxPointCloud2;
     }
     o.UseDriver(d);
@@ -199,7 +208,7 @@ int main(int argc, char** argv) {
     std::cout << ctlio::sim::ListSensorModels();
     return 0;
   }
-  if (FLAGS_output.empty()) {
+  if (FLAGS_output.empty() && FLAGS_geometry_report.empty()) {
     std::cerr << "--output is required\n";
     return 2;
   }
@@ -353,6 +362,29 @@ int main(int argc, char** argv) {
     sim::SimulatedSource source(config, name.str());
     if (!FLAGS_topview.empty()) {
       sim::WriteTopViewSvg(source.simulator().world(), FLAGS_topview, "world " + world_name);
+    }
+    if (!FLAGS_geometry_report.empty()) {
+      eval::WriteGeometryHeader(std::cout);
+      for (const std::string& item : apps::SplitList(FLAGS_geometry_report)) {
+        if (item.find_first_not_of("0123456789") != std::string::npos || item.size() > 9) {
+          throw std::runtime_error("--geometry_report='" + FLAGS_geometry_report +
+                                   "': expected scan indices, e.g. 0,50");
+        }
+        const size_t k = std::stoul(item);
+        if (k >= source.NumScans()) {
+          throw std::runtime_error("--geometry_report: scan " + item + " is not in the " +
+                                   std::to_string(source.NumScans()) + " scans");
+        }
+        // CPU time: the machine may be shared, and the simulator runs on one thread.
+        const std::clock_t c0 = std::clock();
+        const io::PointCloud cloud = source.simulator().Scan(k);
+        const double ms = 1e3 * double(std::clock() - c0) / CLOCKS_PER_SEC;
+        eval::WriteGeometryRow(std::cout, name.str() + " scan " + item,
+                               eval::ComputeGeometryStatistics(cloud.points));
+        LOG(INFO) << "scan " << k << ": " << cloud.size() << " points simulated in " << ms
+                  << " ms CPU";
+      }
+      return 0;
     }
     if (!source.simulator().ImuOutages().empty()) {
       std::ostringstream msg;

@@ -44,7 +44,8 @@ TEST(Presets, NewerCollegeSetsWhatItSays) {
   EXPECT_FALSE(c.imu.body_centric);
   ExpectSameSE3(c.imu_from_lidar, io::NewerCollegeImuFromLidar(), 0.0);
   EXPECT_EQ(c.imu_from_lidar.rotation().diagonal(), Vec3(-1, -1, 1));
-  EXPECT_EQ(c.world.kind, WorldKind::kPark);
+  // The college quad since the realistic worlds (it was the park before).
+  EXPECT_EQ(c.world.kind, WorldKind::kQuad);
   EXPECT_GE(c.duration_s, 60.0);
   EXPECT_LE(c.duration_s, 300.0);
   // The walking regime: guided at 1.2–1.6 m/s with head turns (same draw as ExperimentConfig).

@@ -10,7 +10,7 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "ctlio_simulate failed (${rc}):\n${out}\n${err}")
 endif()
 file(READ ${OUT}/preset/ctlio_sim.yaml meta)
-foreach(field "preset: newer_college" "world: park" "regime: walking" "beams: 16,"
+foreach(field "preset: newer_college" "world: quad" "regime: walking" "beams: 16,"
         "firings_per_revolution: 1024" "imu_rate_hz: 100," "lidar_rate_hz: 10,")
   string(FIND "${meta}" "${field}" at)
   if(at EQUAL -1)

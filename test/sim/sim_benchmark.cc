@@ -1,6 +1,6 @@
 // Simulator speed (the target: a 20 s full-resolution sequence in < 30 s on one core).
 // BM_FullSequence generates every scan and IMU sample of fast/00 in memory; BM_Scan one scan;
-// BM_ScanWorld one scan in each world (box, street, corridor, park, indoor).
+// BM_ScanWorld one scan in each world (box, street, corridor, park, indoor, quad, town, office).
 #include <benchmark/benchmark.h>
 
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -47,7 +47,7 @@ void BM_ScanWorld(benchmark::State& state) {
   state.SetLabel(ctlio::sim::WorldName(world));
   state.counters["returns"] = double(points);
 }
-BENCHMARK(BM_ScanWorld)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScanWorld)->DenseRange(0, 7)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -247,6 +247,16 @@ void Scene::Build(double cell) {
         const Vec3 e(c.radius, c.radius, 0.0);
         return {c.base - e, c.base + e + Vec3(0, 0, c.height)};
       }
+      case kMedium:
+        return {media[r.index].centre - media[r.index].radii,
+                media[r.index].centre + media[r.index].radii};
+      case kGlass:
+        return glass[r.index];
+      case kMover: {  // the lane it walks
+        const Mover& m = movers[r.index];
+        const Vec3 e(m.radius, m.radius, 0.0);
+        return {m.a.cwiseMin(m.b) - e, m.a.cwiseMax(m.b) + e + Vec3(0, 0, m.height)};
+      }
       default: {
         const Sphere& s = spheres[r.index];
         return {s.centre - Vec3::Constant(s.radius), s.centre + Vec3::Constant(s.radius)};
@@ -257,6 +267,9 @@ void Scene::Build(double cell) {
   for (uint32_t i = 0; i < boxes.size(); ++i) all.push_back({kBox, i});
   for (uint32_t i = 0; i < cylinders.size(); ++i) all.push_back({kCylinder, i});
   for (uint32_t i = 0; i < spheres.size(); ++i) all.push_back({kSphere, i});
+  for (uint32_t i = 0; i < media.size(); ++i) all.push_back({kMedium, i});
+  for (uint32_t i = 0; i < glass.size(); ++i) all.push_back({kGlass, i});
+  for (uint32_t i = 0; i < movers.size(); ++i) all.push_back({kMover, i});
   refs_.clear();
   large_.clear();
   cell_start_.assign(1, 0);
@@ -290,6 +303,12 @@ void Scene::Build(double cell) {
     large_.push_back(all.front());
     all.erase(all.begin());
   }
+  for (Ref& r : all) {
+    const Box b = xy_bounds(r);
+    r.zlo = b.min.z();
+    r.zhi = b.max.z();
+  }
+  cell_top_.assign(size_t(nx_) * size_t(ny_), -kInf);
   std::vector<uint32_t> count(size_t(nx_) * size_t(ny_) + 1, 0);
   for (const Ref& r : all) {
     int i0, i1, j0, j1;
@@ -304,49 +323,88 @@ void Scene::Build(double cell) {
     int i0, i1, j0, j1;
     cell_range(xy_bounds(r), &i0, &i1, &j0, &j1);
     for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) refs_[count[size_t(j) * nx_ + i]++] = r;
+      for (int i = i0; i <= i1; ++i) {
+        refs_[count[size_t(j) * nx_ + i]++] = r;
+        cell_top_[size_t(j) * nx_ + i] = std::max(cell_top_[size_t(j) * nx_ + i], r.zhi);
+      }
   }
 }
 
 RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
-                           double t_max) const {
+                           double t_max, double time) const {
   switch (r.kind) {
     case kBox:
       return IntersectBox(boxes[r.index], o, d, inv_d, t_max);
     case kCylinder:
       return IntersectCylinder(cylinders[r.index], o, d, t_max);
+    case kMedium:
+      return IntersectMedium(r.index, o, d, inv_d, t_max);
+    case kGlass:
+      return IntersectBox(glass[r.index], o, d, inv_d, t_max);
+    case kMover: {
+      if (std::isnan(time)) return {};
+      const Mover& m = movers[r.index];
+      return IntersectCylinder({m.At(time), m.radius, m.height}, o, d, t_max);
+    }
     default:
       return IntersectSphere(spheres[r.index], o, d, t_max);
   }
 }
 
 RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max) const {
+  return CastAt(o, d, t_max, std::numeric_limits<double>::quiet_NaN());
+}
+
+RayHit Scene::Cast(const Vec3& o, const Vec3& d, double t_max, double time) const {
+  return CastAt(o, d, t_max, time);
+}
+
+RayHit Scene::CastAt(const Vec3& o, const Vec3& d, double t_max, double time) const {
   RayHit best;
-  auto keep = [&](const RayHit& h) {
-    if (h.t < best.t && h.t < t_max) best = h;
+  bool best_glass = false;  // the nearest hit stops the ray without a return
+  auto keep = [&](const RayHit& h, bool is_glass = false) {
+    if (h.t < best.t && h.t < t_max) {
+      best = h;
+      best_glass = is_glass;
+    }
   };
-  for (const double z : floors) {
-    if (d.z() < 0.0 && o.z() > z) keep({(z - o.z()) / d.z(), Vec3(0, 0, 1)});
+  const bool plain_ground = covers.empty() && relief == 0.0;
+  if (plain_ground) {
+    for (const double z : floors) {
+      if (d.z() < 0.0 && o.z() > z) keep({(z - o.z()) / d.z(), Vec3(0, 0, 1)});
+    }
   }
   for (const double z : ceilings) {
     if (d.z() > 0.0 && o.z() < z) keep({(z - o.z()) / d.z(), Vec3(0, 0, -1)});
   }
-  for (const HeightField& f : fields) keep(IntersectHeightField(f, o, d, std::min(t_max, best.t)));
+  if (plain_ground) {
+    for (const HeightField& f : fields)
+      keep(IntersectHeightField(f, o, d, std::min(t_max, best.t)));
+  } else {
+    keep(CastGround(o, d, t_max));
+  }
   const Vec3 inv_d = d.cwiseInverse();
-  for (const Ref& r : large_) keep(IntersectRef(r, o, d, inv_d, best.t));
-  if (refs_.empty()) return best;
+  for (const Ref& r : large_) keep(IntersectRef(r, o, d, inv_d, best.t, time), r.kind == kGlass);
+  if (refs_.empty()) return best_glass ? RayHit{} : best;
   double t0 = 0.0, t1 = std::min(t_max, best.t);
   ClipXY(o, d, bounds_.min.x(), bounds_.min.y(), bounds_.max.x(), bounds_.max.y(), &t0, &t1);
   ClipZ(o, d, bounds_.min.z(), bounds_.max.z(), &t0, &t1);
   TraverseGrid(bounds_.min.x(), bounds_.min.y(), cell_, nx_, ny_, o, d, t0, t1,
-               [&](int i, int j, double, double tb) {
+               [&](int i, int j, double ta, double tb) {
                  const size_t c = size_t(j) * nx_ + i;
+                 // The ray's heights inside the cell: primitives entirely above or below them
+                 // cannot be hit here (where they can, they are binned into that cell too).
+                 const double za = o.z() + ta * d.z(), zb = o.z() + tb * d.z();
+                 const double lo = std::min(za, zb) - 1e-9, hi = std::max(za, zb) + 1e-9;
+                 if (lo > cell_top_[c]) return false;
                  for (uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
-                   keep(IntersectRef(refs_[k], o, d, inv_d, best.t));
+                   const Ref& r = refs_[k];
+                   if (r.zlo > hi || r.zhi < lo) continue;
+                   keep(IntersectRef(r, o, d, inv_d, best.t, time), r.kind == kGlass);
                  }
                  return best.t <= tb;
                });
-  return best;
+  return best_glass ? RayHit{} : best;
 }
 
 bool Scene::Occupied(const Vec3& p) const {

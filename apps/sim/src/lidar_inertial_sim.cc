@@ -253,13 +253,13 @@ double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
   return r;
 }
 
-RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d) const {
+RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d, double time) const {
   const auto& L = config_.lidar;
   const bool need_normal = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
   if (config_.world.kind == WorldKind::kBox && !need_normal) return {CastRay(o, d), Vec3::Zero()};
   // Farther than this no noise draw brings a return back inside max_range.
   const double reach = L.max_range * (1 + 6 * L.range_noise_per_m) + 6 * L.range_noise + 1.0;
-  return world_.scene.Cast(o, d, reach);
+  return world_.scene.Cast(o, d, reach, time);
 }
 
 void LidarInertialSim::ApplyImuOutages(size_t j) {
@@ -333,7 +333,7 @@ io::PointCloud LidarInertialSim::Scan(size_t k) const {
         const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
         d_ray = Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
       }
-      const RayHit hit = Cast(o, C * d_ray);
+      const RayHit hit = Cast(o, C * d_ray, Seconds(t_ns));
       const double r = hit.t;
       if (!std::isfinite(r) || lost) continue;
       const double m =

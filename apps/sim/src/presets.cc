@@ -10,22 +10,73 @@ namespace ctlio::sim {
 Preset ParsePreset(const std::string& name) {
   if (name.empty() || name == "none") return Preset::kNone;
   if (name == "newer_college") return Preset::kNewerCollege;
-  throw std::runtime_error("unknown preset '" + name + "' (none, newer_college)");
+  if (name == "kitti") return Preset::kKitti;
+  throw std::runtime_error("unknown preset '" + name + "' (none, newer_college, kitti)");
 }
 
 const char* PresetName(Preset preset) {
-  return preset == Preset::kNewerCollege ? "newer_college" : "none";
+  switch (preset) {
+    case Preset::kNewerCollege:
+      return "newer_college";
+    case Preset::kKitti:
+      return "kitti";
+    default:
+      return "none";
+  }
 }
 
 Regime PresetRegime(Preset preset) {
-  return preset == Preset::kNewerCollege ? Regime::kWalking : Regime::kFast;
+  switch (preset) {
+    case Preset::kNewerCollege:
+      return Regime::kWalking;
+    case Preset::kKitti:
+      return Regime::kVehicle;
+    default:
+      return Regime::kFast;
+  }
 }
 
 WorldKind PresetWorld(Preset preset) {
-  return preset == Preset::kNewerCollege ? WorldKind::kPark : WorldKind::kBox;
+  switch (preset) {
+    case Preset::kNewerCollege:
+      return WorldKind::kQuad;
+    case Preset::kKitti:
+      return WorldKind::kTown;
+    default:
+      return WorldKind::kBox;
+  }
 }
 
-double PresetDuration(Preset preset) { return preset == Preset::kNewerCollege ? 120.0 : 20.0; }
+double PresetDuration(Preset preset) {
+  switch (preset) {
+    case Preset::kNewerCollege:
+      return 120.0;
+    case Preset::kKitti:
+      return 60.0;
+    default:
+      return 20.0;
+  }
+}
+
+void ApplyKittiSensors(SimConfig* config) {
+  LidarConfig& L = config->lidar;
+  L.beams = 64;
+  L.min_elevation_deg = -24.8;
+  L.max_elevation_deg = 2.0;
+  L.firings_per_revolution = 2000;
+  L.rate_hz = 10.0;
+  L.range_noise = 0.02;
+  L.range_noise_per_m = 0.0;
+  L.min_range = 2.0;
+  L.max_range = 120.0;
+  ImuConfig& I = config->imu;
+  I.rate_hz = 100.0;
+  I.accel_noise = 0.02;
+  I.gyro_noise = 0.002;
+  I.accel_bias_walk = 1e-4;
+  I.gyro_bias_walk = 1e-5;
+  I.body_centric = false;
+}
 
 void ApplyNewerCollegeSensors(SimConfig* config) {
   LidarConfig& L = config->lidar;
@@ -54,6 +105,7 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrid
                                  o.world.value_or(PresetWorld(preset)));
   c.duration_s = PresetDuration(preset);
   if (preset == Preset::kNewerCollege) ApplyNewerCollegeSensors(&c);
+  if (preset == Preset::kKitti) ApplyKittiSensors(&c);
   if (o.sensor) {
     const SensorModel& m = FindSensorModel(*o.sensor);
     ApplySensorModel(m, &c);

@@ -38,7 +38,7 @@ io::PointCloud LidarInertialSim::PatternScan(size_t k) const {
       const double n = normal(rng);
       const bool lost = L.dropout > 0.0 && Uniform(lost_rng, 0, 1) < L.dropout;
       const Vec3 d_w = C * d_l;
-      const RayHit hit = Cast(o, d_w);
+      const RayHit hit = Cast(o, d_w, t);  // t: where the moving people are
       const double r = hit.t;
       if (!std::isfinite(r) || lost) continue;
       const double m = r + L.range_noise * n + L.range_noise_per_m * r * n;

@@ -38,17 +38,24 @@ const char* WorldName(WorldKind w) {
       return "park";
     case WorldKind::kIndoor:
       return "indoor";
+    case WorldKind::kQuad:
+      return "quad";
+    case WorldKind::kTown:
+      return "town";
+    case WorldKind::kOffice:
+      return "office";
   }
   return "?";
 }
 
 WorldKind ParseWorld(const std::string& name) {
   for (WorldKind w : {WorldKind::kBox, WorldKind::kStreet, WorldKind::kCorridor, WorldKind::kPark,
-                      WorldKind::kIndoor}) {
+                      WorldKind::kIndoor, WorldKind::kQuad, WorldKind::kTown, WorldKind::kOffice}) {
     if (name == WorldName(w)) return w;
   }
-  throw std::runtime_error("unknown world '" + name +
-                           "' (expected box, street, corridor, park or indoor)");
+  throw std::runtime_error(
+      "unknown world '" + name +
+      "' (expected box, street, corridor, park, indoor, quad, town or office)");
 }
 
 World BuildWorld(const WorldConfig& c, const RoomConfig& room) {
@@ -63,6 +70,12 @@ World BuildWorld(const WorldConfig& c, const RoomConfig& room) {
       return BuildParkWorld(c.park, c.seed);
     case WorldKind::kIndoor:
       return BuildIndoorWorld(c.indoor, c.seed);
+    case WorldKind::kQuad:
+      return BuildQuadWorld(c.quad, c.seed);
+    case WorldKind::kTown:
+      return BuildTownWorld(c.town, c.seed);
+    case WorldKind::kOffice:
+      return BuildOfficeWorld(c.office, c.seed);
   }
   throw std::runtime_error("BuildWorld: unknown kind");
 }
@@ -201,6 +214,12 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
       }
     }
   }
+  for (const GroundCover& c : s.covers) {  // grass
+    if (c.x1 < view.min.x() || c.x0 > view.max.x() || c.y1 < view.min.y() || c.y0 > view.max.y())
+      continue;
+    out << "<rect x='" << X(c.x0) << "' y='" << Y(c.y1) << "' width='" << (c.x1 - c.x0) * px
+        << "' height='" << (c.y1 - c.y0) * px << "' fill='#b8d8a0'/>\n";
+  }
   std::vector<Box> boxes = s.boxes;
   std::sort(boxes.begin(), boxes.end(),
             [](const Box& a, const Box& b) { return a.max.z() < b.max.z(); });
@@ -208,13 +227,35 @@ void WriteTopViewSvg(const World& world, const std::string& file, const std::str
     return hi.x() > view.min.x() && lo.x() < view.max.x() && hi.y() > view.min.y() &&
            lo.y() < view.max.y();
   };
+  // Worlds of thousands of façade parts: the small ones (piers, bands, < 1 m² from above) are
+  // left out, the building bodies show.
+  const bool detailed = boxes.size() > 2000;
   for (const Box& b : boxes) {
     if (!visible(b.min, b.max)) continue;
+    if (detailed && (b.max.x() - b.min.x()) * (b.max.y() - b.min.y()) < 1.0) continue;
     const int g = std::clamp(int(200 - 4 * b.max.z()), 60, 200);
     out << "<rect x='" << X(b.min.x()) << "' y='" << Y(b.max.y()) << "' width='"
         << (b.max.x() - b.min.x()) * px << "' height='" << (b.max.y() - b.min.y()) * px
         << "' fill='rgb(" << g << ',' << g << ',' << g + 20
         << ")' fill-opacity='0.6' stroke='#333' stroke-width='0.3'/>\n";
+  }
+  for (const Box& b : s.glass) {
+    if (!visible(b.min, b.max) || detailed) continue;
+    out << "<rect x='" << X(b.min.x()) << "' y='" << Y(b.max.y()) << "' width='"
+        << std::max((b.max.x() - b.min.x()) * px, 0.8) << "' height='"
+        << std::max((b.max.y() - b.min.y()) * px, 0.8) << "' fill='#3080e0'/>\n";
+  }
+  for (const Medium& m : s.media) {  // foliage
+    if (!visible(m.centre, m.centre)) continue;
+    if (m.box) {
+      out << "<rect x='" << X(m.centre.x() - m.radii.x()) << "' y='"
+          << Y(m.centre.y() + m.radii.y()) << "' width='" << 2 * m.radii.x() * px << "' height='"
+          << 2 * m.radii.y() * px << "' fill='#2f6f2f' fill-opacity='0.7'/>\n";
+    } else {
+      out << "<ellipse cx='" << X(m.centre.x()) << "' cy='" << Y(m.centre.y()) << "' rx='"
+          << m.radii.x() * px << "' ry='" << m.radii.y() * px
+          << "' fill='#3a7d3a' fill-opacity='0.45'/>\n";
+    }
   }
   for (const Sphere& c : s.spheres) {
     if (!visible(c.centre, c.centre)) continue;

@@ -6,6 +6,23 @@
 // spheres, and for the height field a 2-D DDA over its cells with the exact root of the quadratic
 // z(t) = h(x(t), y(t)) in each cell (a bilinear patch restricted to a line is a quadratic).
 // Primitives are solid: a ray starting inside one reports its exit, never a hit at t ≤ 0.
+//
+// Besides solids, a scene may hold what real recordings are full of and solids cannot model
+// (docs/user-guide/simulator.md, "Realistic content"):
+//   * scattering media (foliage, hedges): ellipsoids or boxes that are not solid; a ray entering
+//     one returns at an exponentially distributed depth s ~ Exp(free_path) along its chord, or
+//     passes through when s exceeds the chord (Beer–Lambert: a fraction exp(−chord/free_path)
+//     of the rays sees what lies behind);
+//   * ground cover (grass): inside xy rectangles, a layer of `height` over the ground (floors and
+//     height fields) that is such a medium;
+//   * micro-relief: the ground's hits are raised by δz(x, y), a smooth field of amplitude
+//     `relief` (value noise on a 0.6 m lattice), along the ray: t' = t − δz/|d_z| (clamped);
+//   * glass: boxes that stop a ray without a return (windows; the ray gives no point);
+//   * moving people: upright cylinders (body) walking back and forth between two points at a
+//     constant speed, placed by the time of the ray (Cast with a time).
+// The random depth is a pure function of (scene seed, the ray's origin and direction bits, the
+// medium): the same ray always gets the same return, so a scan is still a pure function of the
+// seeds and the scan index. A scene without these gives exactly the hits it gave before.
 #pragma once
 
 #include <cstdint>
@@ -63,6 +80,35 @@ RayHit IntersectCylinder(const Cylinder& c, const Vec3& o, const Vec3& d, double
 RayHit IntersectSphere(const Sphere& s, const Vec3& o, const Vec3& d, double t_max);
 RayHit IntersectHeightField(const HeightField& h, const Vec3& o, const Vec3& d, double t_max);
 
+// A volume of scattering medium: an ellipsoid with semi-axes `radii` (along x, y, z) or, with
+// `box`, the axis-aligned box centre ± radii.
+struct Medium {
+  Vec3 centre = Vec3::Zero();
+  Vec3 radii = Vec3::Ones();
+  double free_path = 0.5;  // mean depth of a return inside [m]
+  bool box = false;
+};
+
+// Grass over the ground inside [x0, x1] × [y0, y1].
+struct GroundCover {
+  double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
+  double height = 0.1;      // layer thickness [m]
+  double free_path = 0.05;  // mean depth of a return inside, along the ray [m]
+  double relief = 0.0;      // extra micro-relief under the cover (tussocks, 0.25 m lattice) [m]
+};
+
+// A person walking back and forth along a → b (ground points) at `speed`: at time τ the arc
+// length s = (speed·τ + phase) mod 2L (L = |b − a|) puts them at a + min(s, 2L − s)/L·(b − a).
+struct Mover {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  double speed = 1.3, phase = 0.0;  // m/s, m
+  double radius = 0.22, height = 1.75;
+  Vec3 At(double time) const;  // the ground point under the person
+};
+
+// Uniform in [0, 1) from the ray (origin and direction bits), the scene seed and a salt.
+double RayUniform(uint64_t seed, const Vec3& o, const Vec3& d, uint64_t salt);
+
 // A world's geometry. Build() must be called after the primitives are added.
 class Scene {
  public:
@@ -72,28 +118,51 @@ class Scene {
   std::vector<double> floors;    // solid half-spaces z ≤ value (the ground)
   std::vector<double> ceilings;  // solid half-spaces z ≥ value
   std::vector<HeightField> fields;
+  std::vector<Medium> media;
+  std::vector<GroundCover> covers;
+  std::vector<Box> glass;
+  std::vector<Mover> movers;  // not in Occupied(): the guide paths keep clear of their lanes
+  double relief = 0.0;        // micro-relief amplitude of the ground [m]
+  uint64_t seed = 0;          // of the per-ray draws in media and ground cover
 
   // Bins the finite primitives into square xy cells of `cell` metres.
   void Build(double cell);
   RayHit Cast(const Vec3& o, const Vec3& d, double t_max) const;
+  // The same with the moving people at `time`.
+  RayHit Cast(const Vec3& o, const Vec3& d, double t_max, double time) const;
+  // True when p lies on or in a moving person at `time` (within 1 mm).
+  bool OnMover(const Vec3& p, double time) const;
   // True when p lies inside a solid (or below the ground / a height field).
   bool Occupied(const Vec3& p) const;
+  // True when p lies in a scattering medium, in the ground cover or within the relief of the
+  // ground (where the returns of those lie, off the solids).
+  bool InMedium(const Vec3& p) const;
+  // The relief's height offset δz at (x, y) (0 without relief).
+  double Relief(double x, double y) const;
   // Axis-aligned bounds of the finite primitives (for pictures and the grid).
   Box Bounds() const { return bounds_; }
 
  private:
-  enum Kind : uint32_t { kBox = 0, kCylinder = 1, kSphere = 2 };
+  enum Kind : uint32_t { kBox, kCylinder, kSphere, kMedium, kGlass, kMover };
   struct Ref {
     uint32_t kind, index;
+    double zlo = 0.0, zhi = 0.0;  // the primitive's vertical extent (culling along the ray)
   };
   Box bounds_;
   double cell_ = 1.0;
   int nx_ = 0, ny_ = 0;
   std::vector<uint32_t> cell_start_;  // CSR: refs of cell c are refs_[cell_start_[c] ...)
+  std::vector<double> cell_top_;      // highest point of the refs of cell c
   std::vector<Ref> refs_;
   std::vector<Ref> large_;  // tested once per ray, not binned
-  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
-                      double t_max) const;
+  // `time` NaN: the static scene (movers are skipped).
+  RayHit IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d, double t_max,
+                      double time) const;
+  RayHit CastAt(const Vec3& o, const Vec3& d, double t_max, double time) const;
+  RayHit IntersectMedium(uint32_t index, const Vec3& o, const Vec3& d, const Vec3& inv_d,
+                         double t_max) const;
+  // The ground hit (floors, height fields) with relief and cover applied.
+  RayHit CastGround(const Vec3& o, const Vec3& d, double t_max) const;
 };
 
 }  // namespace ctlio::sim

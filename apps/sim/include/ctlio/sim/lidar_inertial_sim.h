@@ -233,7 +233,8 @@ class LidarInertialSim {
   Vec6 LocalTwistRate(double t) const;
   SE3 LocalPose(double t) const;
   // The nearest surface along a ray (normals only where realism needs them in the box room).
-  RayHit Cast(const Vec3& o, const Vec3& d) const;
+  // `time` [s since the start] places the world's moving people (Scene::movers).
+  RayHit Cast(const Vec3& o, const Vec3& d, double time = 0.0) const;
   // Scan k of a non-repetitive pattern (sensor_scan.cc).
   io::PointCloud PatternScan(size_t k) const;
   // IMU j's samples, biases and outages (IMU 0 draws from the single-IMU streams).

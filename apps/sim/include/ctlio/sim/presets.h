@@ -11,7 +11,15 @@
 //   1e-4 rad/s/√s (a consumer MEMS IMU), initial biases 0.05, g = 9.81599 m/s² (SPEC §4).
 //   Extrinsic: the published T_imu_lidar (rotation diag(−1, −1, 1), translation (−0.006253,
 //   0.011775, 0.028535) m; SPEC §6). Motion: the walking regime (≈1.4 m/s with gait and head
-//   turns) in the park world; 120 s.
+//   turns) in the college quad (`quad`, worlds.h: buildings round a lawn, an arch, a park with
+//   trees); 120 s. (Until the quad existed the preset walked in `park`; --world park gives that.)
+//
+// `kitti` (KITTI odometry, Velodyne HDL-64E on a car): 64 beams evenly spaced over +2° … −24.8°
+//   (the real lasers are in two blocks, ≈1/3° and ≈1/2° apart: uniform spacing is the
+//   approximation here), 2000 firings per revolution (≈0.18°, ~120 k returns a sweep as KITTI's
+//   scans have), 10 Hz, range 2–120 m, σ = 2 cm (datasheet: < 2 cm); a car-grade IMU at 100 Hz
+//   (σ_a = 0.02 m/s², σ_g = 0.002 rad/s, small bias walks), identity extrinsic. Motion: the
+//   vehicle regime (8–14 m/s) in the town street (`town`); 60 s.
 // The exact specific force is generated (the real accelerometer measures it).
 #pragma once
 
@@ -22,8 +30,9 @@
 
 namespace ctlio::sim {
 
-enum class Preset { kNone, kNewerCollege };
-// "" or "none" → kNone, "newer_college" → kNewerCollege; throws std::runtime_error otherwise.
+enum class Preset { kNone, kNewerCollege, kKitti };
+// "" or "none" → kNone, "newer_college" → kNewerCollege, "kitti" → kKitti; throws
+// std::runtime_error otherwise.
 Preset ParsePreset(const std::string& name);
 const char* PresetName(Preset preset);
 
@@ -57,5 +66,6 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed = kExperimentSeed
 
 // The preset's sensors, IMU and extrinsic applied to `config` (motion, world and duration kept).
 void ApplyNewerCollegeSensors(SimConfig* config);
+void ApplyKittiSensors(SimConfig* config);
 
 }  // namespace ctlio::sim

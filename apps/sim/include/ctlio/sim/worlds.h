@@ -14,9 +14,10 @@
 
 namespace ctlio::sim {
 
-enum class WorldKind { kBox, kStreet, kCorridor, kPark, kIndoor };
+enum class WorldKind { kBox, kStreet, kCorridor, kPark, kIndoor, kQuad, kTown, kOffice };
 const char* WorldName(WorldKind w);
-WorldKind ParseWorld(const std::string& name);  // box | street | corridor | park | indoor
+// box | street | corridor | park | indoor | quad | town | office
+WorldKind ParseWorld(const std::string& name);
 
 struct Range {
   double lo = 0.0, hi = 0.0;
@@ -86,6 +87,70 @@ struct IndoorParams {
   int tables_per_room = 2;
 };
 
+// The realistic worlds (docs/user-guide/simulator.md, "Realistic content"; built from
+// src/world_content.h): façades with windows (recesses, glass returning nothing), ledges,
+// balconies and doors; trees and bushes whose crowns are scattering media; hedges; grass as a
+// scattering layer over a ground with micro-relief; parked cars, poles, people (standing, and
+// walking back and forth on lanes clear of the path), benches; furniture.
+// Free paths are the mean depth of a return inside a medium.
+struct VegetationParams {
+  double crown_free_path = 0.8;  // tree crowns [m]
+  double bush_free_path = 0.5;
+  double hedge_free_path = 0.35;
+  double grass_height = 0.1;      // [m]
+  double grass_free_path = 0.08;  // [m]
+  double relief = 0.03;           // ground micro-relief amplitude [m] (0.6 m lattice)
+  double grass_relief = 0.04;     // extra relief under grass [m] (tussocks, 0.25 m lattice)
+};
+
+// College quad (Newer College-like): a lawn of lawn_x × lawn_y inside a ring of stone buildings
+// (3–4 storeys, windows), a walkway of `walkway` between lawn and façades, an arch through the
+// east range into a park (trees, bushes, hedges, benches) of park × park. The path goes round the
+// quad on the walkway, through the arch, round the park and back.
+struct QuadParams {
+  double lawn_x = 48.0, lawn_y = 36.0, walkway = 4.0;
+  Range depth{9, 13};     // building depth [m]
+  Range segment{14, 30};  // length of one building along a side [m]
+  double storey = 3.6;
+  double arch_width = 5.0, arch_height = 4.2;
+  double park = 90.0, park_gap = 6.0;  // park side; distance east of the east range
+  double park_trees_per_hectare = 30.0, park_bushes_per_hectare = 20.0;
+  int quad_trees = 4, people = 8, benches = 6;
+  int walkers = 8;  // moving people: half on the lawn, half in the park
+  VegetationParams vegetation;
+};
+
+// Town street (KITTI-like): a rectangular loop of streets (length × width centreline) around one
+// block, with kerbs and raised pavements, rows of houses (2–5 storeys, windows, balconies) behind
+// front gardens (grass, hedges, bushes, trees), street trees at the kerb, parked cars on both
+// sides, poles and signs, people on the pavements. The vehicle drives on the right-hand lane.
+struct TownParams {
+  double length = 300.0, width = 110.0;
+  double road_half_width = 5.5, pavement = 3.0, lane_offset = 1.8;
+  double corner_radius = 10.0, corner_clear = 9.5;
+  Range garden{2, 9};  // pavement → façade [m]
+  Range house_width{9, 20}, house_depth{9, 14}, gap{1, 7};
+  int min_storeys = 2, max_storeys = 5;
+  double hedge_probability = 0.85;   // per house: a hedge along the pavement
+  Range street_tree_spacing{5, 10};  // at the kerb [m]
+  double car_probability = 0.65;     // per 6 m kerb slot
+  Range pole_spacing{18, 30};
+  double people_per_100m = 3.0;
+  double walkers_per_100m = 1.0;  // moving people, per side of a street
+  VegetationParams vegetation;
+};
+
+// Office floor: an open-plan floor of size_x × size_y × height with windows along both long walls,
+// a central core (meeting rooms) lined with shelves, desk rows with chairs, monitors and screens
+// between the path loop and the windows, shelves and cabinets on the end walls, columns, plants
+// and ceiling lamps. The path loops round the core.
+struct OfficeParams {
+  double size_x = 40.0, size_y = 24.0, height = 3.0;
+  double core_x = 16.0, core_y = 6.0;  // central block
+  double aisle = 2.4;                  // free band the path runs in, around the core
+  int plants = 8;
+};
+
 // The box room is SimConfig::room (it predates the other worlds).
 struct WorldConfig {
   WorldKind kind = WorldKind::kBox;
@@ -94,6 +159,9 @@ struct WorldConfig {
   CorridorParams corridor;
   ParkParams park;
   IndoorParams indoor;
+  QuadParams quad;
+  TownParams town;
+  OfficeParams office;
 };
 
 struct World {
@@ -111,6 +179,9 @@ World BuildStreetWorld(const StreetParams& p, uint64_t seed);
 World BuildCorridorWorld(const CorridorParams& p);
 World BuildParkWorld(const ParkParams& p, uint64_t seed);
 World BuildIndoorWorld(const IndoorParams& p, uint64_t seed);
+World BuildQuadWorld(const QuadParams& p, uint64_t seed);
+World BuildTownWorld(const TownParams& p, uint64_t seed);
+World BuildOfficeWorld(const OfficeParams& p, uint64_t seed);
 
 // The generator of a world's random draws: mt19937_64 over std::seed_seq{seed, kind}.
 std::mt19937_64 WorldRandom(uint64_t seed, WorldKind kind);
