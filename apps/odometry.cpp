@@ -27,6 +27,8 @@
 // makes IMU gaps in the dataset files an error instead of a warning (docs/user-guide/bad-input.md).
 // --save_map FILE.pcd|.ply writes the registered, deskewed points as a voxel-downsampled map and
 // a top view FILE.png of it with the trajectory (apps/lio/map_accumulator.h, map_output.h).
+// --pose_covariance also writes DIR/trajectory_covariance.csv (each scan's pose covariance, also
+// in the --write_bag messages; docs/user-guide/outputs.md).
 // It says first which config it runs (or the built-in defaults), shows its progress on stderr
 // (apps/lio/progress.h) and ends with the summary and the list of the files written (every writer
 // registers its file with `files.Add(path, description)`, apps/lio/output_files.h).
@@ -62,6 +64,7 @@
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
 #include "lio/config_origin.h"
+#include "lio/covariance_output.h"
 #include "lio/map_accumulator.h"
 #include "lio/map_output.h"
 #include "lio/output_files.h"
@@ -404,6 +407,12 @@ int main(int argc, char** argv) {
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       files.Add(out + "/trajectory.tum",
                 "T_world_lidar at every scan end (TUM: t x y z qx qy qz qw)");
+      if (FLAGS_pose_covariance) {
+        lioapp::WriteTrajectoryCovariance(out + "/trajectory_covariance.csv", run.scans);
+        files.Add(out + "/trajectory_covariance.csv",
+                  "each scan's 6x6 pose covariance: t + 21 upper-triangle entries, [rho; phi] "
+                  "left perturbation of T_world_lidar (docs/user-guide/outputs.md)");
+      }
       if (!run.dense.empty()) {
         io::WriteTum(out + "/trajectory_dense.tum", run.dense);
         files.Add(
@@ -435,7 +444,12 @@ int main(int argc, char** argv) {
         lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
       if (FLAGS_write_bag) {
-        io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+        if (FLAGS_pose_covariance) {
+          io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory,
+                               lioapp::RosPoseCovariances(run.trajectory, run.scans));
+        } else {
+          io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
+        }
         files.Add(out + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)");
       }
       if (map) {

@@ -82,5 +82,32 @@ TEST(PoseCovariance, KnotPoseIsMappedByTheAdjointOfTheInverse) {
   EXPECT_GT(MonteCarloNees(T_rm, prior, true, prior), 12.0);
 }
 
+// The dense path with the lidar information rescaled: scale 1 is ceres::Covariance, and a
+// window whose only information is the "lidar" block scales with it.
+TEST(PoseCovariance, ScaledDenseCovarianceAndChiSquareScale) {
+  const SE3 T_wb = FarPose();
+  const Mat6 prior = PriorCovariance();
+  SlidingWindow window;
+  window.AddPoseState(0, T_wb);
+  const ceres::ResidualBlockId block =
+      window.AddResidualBlock(PosePrior::FromCovariance(T_wb, prior), nullptr, {0});
+  for (const double scale : {1.0, 4.0}) {
+    const std::optional<Mat6> S =
+        ScaledPoseCovariance(window, 0, {block}, scale, T_wb, T_wb.Adjoint());
+    ASSERT_TRUE(S.has_value());
+    EXPECT_LT((*S - scale * prior).norm(), 1e-9 * scale * prior.norm());
+  }
+  // A residual of whitened size 3 in each of 6 components: s = 2·(½·6·9)/6 = 9.
+  const Mat6 sqrt_info = SqrtInformationFromCovariance<6>(prior);
+  const Vec6 offset = sqrt_info.inverse() * Vec6::Constant(3.0);
+  const SE3 mean = SE3::Exp(-offset) * T_wb;
+  SlidingWindow shifted;
+  shifted.AddPoseState(0, T_wb);
+  const ceres::ResidualBlockId far =
+      shifted.AddResidualBlock(PosePrior::FromCovariance(mean, prior), nullptr, {0});
+  EXPECT_NEAR(LidarChiSquareScale(&shifted.problem(), {far}), 9.0, 1e-9);
+  EXPECT_DOUBLE_EQ(LidarChiSquareScale(&shifted.problem(), {}), 1.0);
+}
+
 }  // namespace
 }  // namespace ctlio::lio

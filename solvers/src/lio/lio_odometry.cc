@@ -248,6 +248,8 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 }
 
 void LioOdometry::ReportPoseCovariance(ScanResult* result) {
+  // Not rescaled by the lidar term's own χ² (ScaledPoseCovariance, LidarChiSquareScale): on the
+  // tuning sequences that made the baseline 40x overconfident (docs/experiments/covariance.md).
   // A rank-deficient window gives no covariance (the scan then has none).
   const std::optional<Mat6> S =
       PoseCovariance(&window_.problem(), window_.State(estimator_->NewestPoseKey()), result->T_mr,

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <stdexcept>
+#include <string>
 
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/rosbag_source.h"
@@ -125,10 +126,24 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
 void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
                       const std::string& topic, const std::string& frame,
                       const std::string& child_frame) {
+  WriteOdometryBag(path, trajectory, std::vector<std::array<double, 36>>(trajectory.size()), topic,
+                   frame, child_frame);
+}
+
+void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::vector<std::array<double, 36>>& pose_covariances,
+                      const std::string& topic, const std::string& frame,
+                      const std::string& child_frame) {
+  if (pose_covariances.size() != trajectory.size()) {
+    throw std::invalid_argument(path + ": " + std::to_string(pose_covariances.size()) +
+                                " pose covariances for " + std::to_string(trajectory.size()) +
+                                " poses");
+  }
   try {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
-    for (const StampedPose& p : trajectory) {
-      const auto o = OdometryMsg(p, frame, child_frame);
+    for (size_t k = 0; k < trajectory.size(); ++k) {
+      auto o = OdometryMsg(trajectory[k], frame, child_frame);
+      for (size_t i = 0; i < 36; ++i) o.pose.covariance[i] = pose_covariances[k][i];
       bag.write(topic, o.header.stamp, o);
     }
     bag.close();

@@ -23,6 +23,7 @@
 // with a warning.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -106,6 +107,13 @@ size_t WriteRosbag(DataSource& source, const std::string& path,
 // Writes a trajectory as nav_msgs/Odometry messages on `topic` (frame_id `frame`, child
 // `child_frame`), for viewing an estimate in the users' ROS tools.
 void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::string& topic = "/ctlio/odometry",
+                      const std::string& frame = "map",
+                      const std::string& child_frame = "os_lidar");
+// The same with each message's pose.covariance (ROS row-major 6×6 over [x y z roll pitch yaw];
+// one per pose; lioapp::RosPoseCovariance). Throws std::invalid_argument on a count mismatch.
+void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::vector<std::array<double, 36>>& pose_covariances,
                       const std::string& topic = "/ctlio/odometry",
                       const std::string& frame = "map",
                       const std::string& child_frame = "os_lidar");
