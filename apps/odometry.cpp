@@ -27,8 +27,6 @@
 // makes IMU gaps in the dataset files an error instead of a warning (docs/user-guide/bad-input.md).
 // --save_map FILE.pcd|.ply writes the registered, deskewed points as a voxel-downsampled map and
 // a top view FILE.png of it with the trajectory (apps/lio/map_accumulator.h, map_output.h).
-// --pose_covariance also writes DIR/trajectory_covariance.csv (each scan's pose covariance, also
-// in the --write_bag messages; docs/user-guide/outputs.md).
 // It says first which config it runs (or the built-in defaults), shows its progress on stderr
 // (apps/lio/progress.h) and ends with the summary and the list of the files written (every writer
 // registers its file with `files.Add(path, description)`, apps/lio/output_files.h).
@@ -64,7 +62,6 @@
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/calibration_output.h"
 #include "lio/config_origin.h"
-#include "lio/covariance_output.h"
 #include "lio/map_accumulator.h"
 #include "lio/map_output.h"
 #include "lio/output_files.h"
@@ -141,8 +138,8 @@ DEFINE_string(sim_imus, "",
               "accel_noise, gyro_noise, accel_bias, gyro_bias, outage; apps/sim imu_specs.h), e.g. "
               "rate=400,xyz=0.3:0:0,offset=0.0013,accel_noise=0.04,gyro_noise=0.02");
 DEFINE_bool(pose_covariance, false,
-            "Covariance of every scan's pose (window.pose_covariance) and, with ground truth, its "
-            "NEES in evaluation.txt");
+            "Each scan's pose covariance (window.pose_covariance) in trajectory_covariance.csv "
+            "and --write_bag; with ground truth its NEES in evaluation.txt");
 DEFINE_double(sim_imu_stamp_offset, 0.0,
               "--format sim: IMU 0's samples of the motion at t are stamped t - this [s] (the "
               "clock offset the online calibration should find; other IMUs: stamp_offset= in "
@@ -407,12 +404,7 @@ int main(int argc, char** argv) {
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       files.Add(out + "/trajectory.tum",
                 "T_world_lidar at every scan end (TUM: t x y z qx qy qz qw)");
-      if (FLAGS_pose_covariance) {
-        lioapp::WriteTrajectoryCovariance(out + "/trajectory_covariance.csv", run.scans);
-        files.Add(out + "/trajectory_covariance.csv",
-                  "each scan's 6x6 pose covariance: t + 21 upper-triangle entries, [rho; phi] "
-                  "left perturbation of T_world_lidar (docs/user-guide/outputs.md)");
-      }
+      if (FLAGS_pose_covariance) lioapp::WriteTrajectoryCovariance(out, run.scans, &files);
       if (!run.dense.empty()) {
         io::WriteTum(out + "/trajectory_dense.tum", run.dense);
         files.Add(
@@ -444,12 +436,8 @@ int main(int argc, char** argv) {
         lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
       if (FLAGS_write_bag) {
-        if (FLAGS_pose_covariance) {
-          io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory,
-                               lioapp::RosPoseCovariances(run.trajectory, run.scans));
-        } else {
-          io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory);
-        }
+        io::WriteOdometryBag(out + "/trajectory.bag", run.trajectory,
+                             lioapp::RosPoseCovariances(run));
         files.Add(out + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)");
       }
       if (map) {

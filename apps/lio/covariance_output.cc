@@ -18,7 +18,9 @@ std::array<double, 21> UpperTriangle(const Mat6& S) {
   return out;
 }
 
-void WriteTrajectoryCovariance(const std::string& path, const std::vector<lio::ScanResult>& scans) {
+void WriteTrajectoryCovariance(const std::string& dir, const std::vector<lio::ScanResult>& scans,
+                               OutputFiles* files) {
+  const std::string path = dir + "/trajectory_covariance.csv";
   std::ofstream f = io::OpenForWriting(path);
   // ρ = [x y z], φ = [rx ry rz] (rotation vector about the world axes).
   const char* axes[6] = {"x", "y", "z", "rx", "ry", "rz"};
@@ -39,6 +41,9 @@ void WriteTrajectoryCovariance(const std::string& path, const std::vector<lio::S
     f << '\n';
   }
   io::CloseChecked(f, path);
+  files->Add(path,
+             "each scan's 6x6 pose covariance: t + 21 upper-triangle entries, [rho; phi] left "
+             "perturbation of T_world_lidar (docs/user-guide/outputs.md)");
 }
 
 std::array<double, 36> RosPoseCovariance(const Mat6& S, const SE3& T) {
@@ -52,15 +57,14 @@ std::array<double, 36> RosPoseCovariance(const Mat6& S, const SE3& T) {
   return out;
 }
 
-std::vector<std::array<double, 36>> RosPoseCovariances(
-    const std::vector<io::StampedPose>& trajectory, const std::vector<lio::ScanResult>& scans) {
+std::vector<std::array<double, 36>> RosPoseCovariances(const RunSummary& run) {
   std::map<int64_t, const Mat6*> by_time;
-  for (const lio::ScanResult& r : scans) {
+  for (const lio::ScanResult& r : run.scans) {
     if (r.has_pose_covariance) by_time[r.t_ns] = &r.pose_covariance;
   }
   std::vector<std::array<double, 36>> out;
-  out.reserve(trajectory.size());
-  for (const io::StampedPose& p : trajectory) {
+  out.reserve(run.trajectory.size());
+  for (const io::StampedPose& p : run.trajectory) {
     const auto it = by_time.find(p.t_ns);
     out.push_back(it == by_time.end() ? std::array<double, 36>{}
                                       : RosPoseCovariance(*it->second, p.pose));

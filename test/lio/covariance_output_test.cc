@@ -27,8 +27,10 @@ TEST(CovarianceOutput, CsvHoldsTimeAndUpperTriangleRowByRow) {
   scans[2].t_ns = 300'000'000;
   scans[2].has_pose_covariance = true;
   scans[2].status = lio::ScanStatus::kFailed;  // failed: left out
-  const std::string path = (testing::FreshTempDir("covariance_csv") / "c.csv").string();
-  WriteTrajectoryCovariance(path, scans);
+  const std::string dir = testing::FreshTempDir("covariance_csv").string();
+  OutputFiles files;
+  WriteTrajectoryCovariance(dir, scans, &files);
+  const std::string path = dir + "/trajectory_covariance.csv";
   std::ifstream f(path);
   std::string header, line, extra;
   ASSERT_TRUE(std::getline(f, header));
