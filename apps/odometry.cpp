@@ -143,8 +143,8 @@ DEFINE_string(sim_imus, "",
               "accel_noise, gyro_noise, accel_bias, gyro_bias, outage; apps/sim imu_specs.h), e.g. "
               "rate=400,xyz=0.3:0:0,offset=0.0013,accel_noise=0.04,gyro_noise=0.02");
 DEFINE_bool(pose_covariance, false,
-            "Covariance of every scan's pose (window.pose_covariance) and, with ground truth, its "
-            "NEES in evaluation.txt");
+            "Each scan's pose covariance (window.pose_covariance) in trajectory_covariance.csv "
+            "and --write_bag; with ground truth its NEES in evaluation.txt");
 DEFINE_double(sim_imu_stamp_offset, 0.0,
               "--format sim: IMU 0's samples of the motion at t are stamped t - this [s] (the "
               "clock offset the online calibration should find; other IMUs: stamp_offset= in "
@@ -428,6 +428,7 @@ int main(int argc, char** argv) {
       io::WriteTum(out + "/trajectory.tum", run.trajectory);
       files.Add(out + "/trajectory.tum",
                 "T_world_lidar at every scan end (TUM: t x y z qx qy qz qw)");
+      if (FLAGS_pose_covariance) lioapp::WriteTrajectoryCovariance(out, run.scans, &files);
       if (!run.dense.empty()) {
         io::WriteTum(out + "/trajectory_dense.tum", run.dense);
         files.Add(
@@ -459,7 +460,8 @@ int main(int argc, char** argv) {
         lioapp::WriteCalibrationOutputs(out, run, recommended, &files, ev);
       }
       if (FLAGS_write_bag) {
-        const auto [bag, what] = io::WriteEstimateBag(out, run.source, run.trajectory);
+        const auto [bag, what] =
+            io::WriteEstimateBag(out, run.source, run.trajectory, lioapp::RosPoseCovariances(run));
         files.Add(bag, what);
       }
       if (map) {

@@ -7,7 +7,8 @@ Each method folder is what ctlio_odometry writes: trajectory.tum (scan-end poses
 trajectory_dense.tum and trajectory_dense_live.tum (optional, --trajectory_rate: the dense
 trajectory from the final estimates, and the live one stitched from each scan's window as it was
 returned), scans.log, evaluation.txt and, with ground truth, ground_truth.tum and pose_errors.csv
-(aligned scan poses and their position/rotation errors). Writes <method_dir>/odometry.png and,
+(aligned scan poses and their position/rotation errors), trajectory_covariance.csv (optional,
+--pose_covariance: drawn as the 3σ band of the position under its error). Writes <method_dir>/odometry.png and,
 for several methods, <out_dir>/comparison.png:
   * top view (x-y) and side view (x-z) in metres: ground truth, the estimate at the densest rate
     written ("dense, final estimates"; in the single-method figure also "dense, live, causal"),
@@ -123,6 +124,10 @@ class Run:
             lo, hi = self.scan_t[0] - 0.05, self.scan_t[-1] + 0.05
             self.truth = [r for r in self.truth if lo <= r[0] <= hi]
         self.errors = read_errors(os.path.join(folder, "pose_errors.csv"))
+        # With --pose_covariance: (t, 3σ of the position [m]) per scan, σ² = trace of the
+        # translation block (docs/user-guide/outputs.md, trajectory_covariance.csv).
+        self.sigma3 = [(c["t"], 3.0 * (c["c_x_x"] + c["c_y_y"] + c["c_z_z"]) ** 0.5)
+                       for c in read_errors(os.path.join(folder, "trajectory_covariance.csv"))]
         self.scans = read_scans(os.path.join(folder, "scans.log"))
         self.t0 = self.scans[0][0] if self.scans else (self.scan_t[0] if self.scan_t else 0.0)
 
@@ -171,6 +176,10 @@ def draw_errors(ax, runs, single):
         t = [e["t_s"] - run.t0 for e in run.errors]
         ax.plot(t, [100.0 * e["position_error_m"] for e in run.errors], color=colour,
                 label="position" if single else run.method)
+        if run.sigma3:
+            ax.fill_between([c[0] - run.t0 for c in run.sigma3],
+                            [100.0 * c[1] for c in run.sigma3], color=colour, alpha=0.15, lw=0,
+                            label="3σ of the position (filter)" if single else None)
         if ax_rot is not None:
             ax_rot.plot(t, [e["rotation_error_deg"] for e in run.errors], color="#2ca02c",
                         ls="--", label="rotation")

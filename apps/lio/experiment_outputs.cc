@@ -1,6 +1,7 @@
 #include "experiment_outputs.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -193,11 +194,13 @@ void WriteNees(const std::string& out, const std::vector<ExperimentJob>& jobs,
                OutputFiles* written) {
   std::ofstream f = io::OpenForWriting(out + "/nees.csv");
   f << "regime,sequence,method,scenario,scans,nees_pose,nees_translation,nees_rotation,"
-       "bias_error_accel,bias_error_gyro\n"
+       "bias_error_accel,bias_error_gyro,coverage_x,coverage_y,coverage_z,coverage_rx,"
+       "coverage_ry,coverage_rz\n"
     << std::setprecision(10);
   struct Sum {
     double pose = 0, translation = 0, rotation = 0;
     size_t scans = 0;
+    std::array<size_t, 6> inside{};  // per axis, the scans inside ±3σ
     int runs = 0;
   };
   std::vector<std::pair<std::string, Sum>> cells;
@@ -220,7 +223,11 @@ void WriteNees(const std::string& out, const std::vector<ExperimentJob>& jobs,
     }
     f << j.regime << ',' << j.index << ',' << j.method << ',' << j.scenario << ','
       << j.run.nees.size() << ',' << Mean(j.run.nees) << ',' << Mean(j.run.nees_translation) << ','
-      << Mean(j.run.nees_rotation) << ',' << ea << ',' << eg << '\n';
+      << Mean(j.run.nees_rotation) << ',' << ea << ',' << eg;
+    for (const size_t inside : j.run.nees_inside_3sigma) {
+      f << ',' << (j.run.nees.empty() ? NAN : double(inside) / double(j.run.nees.size()));
+    }
+    f << '\n';
     const std::string key = j.regime + " | " + j.method + " | " + j.scenario;
     auto it =
         std::find_if(cells.begin(), cells.end(), [&](const auto& c) { return c.first == key; });
@@ -231,17 +238,24 @@ void WriteNees(const std::string& out, const std::vector<ExperimentJob>& jobs,
       it->second.rotation += j.run.nees_rotation[k];
     }
     it->second.scans += j.run.nees.size();
+    for (size_t a = 0; a < 6; ++a) it->second.inside[a] += j.run.nees_inside_3sigma[a];
     ++it->second.runs;
   }
   io::CloseChecked(f, out + "/nees.csv");
   written->Add(out + "/nees.csv", "mean NEES and bias errors per run");
   std::ostringstream md;
   md << "| regime | method | scenario | runs | scans | NEES pose (6) | translation (3) | rotation "
-        "(3) |\n|---|---|---|---|---|---|---|---|\n";
+        "(3) | 3σ coverage x y z rx ry rz (%) |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [key, c] : cells) {
     const double n = std::max<double>(1.0, double(c.scans));
     md << "| " << key << " | " << c.runs << " | " << c.scans << " | " << c.pose / n << " | "
-       << c.translation / n << " | " << c.rotation / n << " |\n";
+       << c.translation / n << " | " << c.rotation / n << " |";
+    for (const size_t inside : c.inside) {
+      char pct[16];
+      std::snprintf(pct, sizeof(pct), " %.1f", 100.0 * double(inside) / n);
+      md << pct;
+    }
+    md << " |\n";
   }
   io::WriteTextFile(out + "/nees.md", md.str());
   written->Add(out + "/nees.md", "the consistency table (Markdown)");

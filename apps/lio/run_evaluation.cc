@@ -100,7 +100,13 @@ void WriteRunEvaluation(const RunSummary& run,
   if (!run.nees.empty()) {
     ev << "nees_pose_mean " << Mean(run.nees) << "\nnees_translation_mean "
        << Mean(run.nees_translation) << "\nnees_rotation_mean " << Mean(run.nees_rotation)
-       << "\nnees_scans " << run.nees.size() << "\n";
+       << "\nnees_scans " << run.nees.size() << "\ncoverage_3sigma";
+    // Per axis [x y z rx ry rz] of ε: the fraction of the scans inside ±3σ (0.997 if Gaussian
+    // and consistent).
+    for (const size_t inside : run.nees_inside_3sigma) {
+      ev << ' ' << double(inside) / double(run.nees.size());
+    }
+    ev << "\n";
   }
   if (run.ate) {
     ev << "ate_rmse_m " << run.ate->rmse << "\nate_mean_m " << run.ate->mean << "\nate_max_m "

@@ -101,6 +101,9 @@ void PoseNees(const std::vector<lio::ScanResult>& scans, const std::vector<io::S
         e.head<3>().dot(S.topLeftCorner<3, 3>().ldlt().solve(Vec3(e.head<3>()))));
     run->nees_rotation.push_back(
         e.tail<3>().dot(S.bottomRightCorner<3, 3>().ldlt().solve(Vec3(e.tail<3>()))));
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(e[i]) <= 3.0 * std::sqrt(S(i, i))) ++run->nees_inside_3sigma[size_t(i)];
+    }
   }
 }
 

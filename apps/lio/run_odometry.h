@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -119,6 +120,8 @@ struct RunSummary {
   // the NEES of the pose, ε = Log(T_mr,true·T_mr⁻¹), εᵀΣ⁻¹ε (6 if consistent), and of its
   // translation and rotation parts alone (3 each), with T_mr,true anchored at the first scan.
   std::vector<double> nees, nees_translation, nees_rotation;
+  // Per axis of ε = [ρ; φ]: the scans whose error lies within ±3σ of that axis (of nees.size()).
+  std::array<size_t, 6> nees_inside_3sigma{};
   // Extrinsic T_imu_lidar: the one the run started from (config or source), the last estimated
   // one with its marginal σ [ρ; φ] (calibration.estimate_extrinsic; else the starting one, σ 0),
   // and the truth where the source knows it (simulator: DataSource::TrueImuFromLidar).

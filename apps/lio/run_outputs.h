@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "covariance_output.h"  // the pose covariance files
 #include "ctlio/io/dataset.h"
 #include "run_odometry.h"
 

@@ -6,7 +6,9 @@
 // all bags here are written by the tests.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 
 #include <filesystem>
@@ -331,6 +333,31 @@ TEST(Rosbag, OdometryBagHoldsTheTrajectory) {
     EXPECT_EQ((*read)[k].t_ns, trajectory[k].t_ns);
     EXPECT_LT(((*read)[k].pose.Matrix() - trajectory[k].pose.Matrix()).norm(), 1e-12);
   }
+}
+
+// With covariances, each message carries its own (row-major 36, as given).
+TEST(Rosbag, OdometryBagHoldsThePoseCovariances) {
+  const fs::path d = testing::FreshTempDir("rosbag_odometry_covariance");
+  std::vector<StampedPose> trajectory(2);
+  trajectory[0].t_ns = 100'000'000;
+  trajectory[1].t_ns = 200'000'000;
+  std::vector<std::array<double, 36>> covariances(2);
+  for (size_t i = 0; i < 36; ++i) covariances[1][i] = 0.5 + double(i);
+  const std::string path = (d / "trajectory.bag").string();
+  WriteOdometryBag(path, trajectory, covariances);
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  std::vector<nav_msgs::Odometry> read;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    const nav_msgs::Odometry::ConstPtr o = m.instantiate<nav_msgs::Odometry>();
+    if (o) read.push_back(*o);
+  }
+  ASSERT_EQ(read.size(), 2u);
+  for (size_t i = 0; i < 36; ++i) {
+    EXPECT_EQ(read[0].pose.covariance[i], 0.0);
+    EXPECT_EQ(read[1].pose.covariance[i], 0.5 + double(i));
+  }
+  covariances.pop_back();
+  EXPECT_THROW(WriteOdometryBag(path, trajectory, covariances), std::invalid_argument);
 }
 
 TEST(Rosbag, AccelerometerScale) {

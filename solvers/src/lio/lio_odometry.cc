@@ -1,11 +1,10 @@
 #include "ctlio/solvers/lio/lio_odometry.h"
 
-#include <ceres/covariance.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,6 +12,7 @@
 #include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/input_checks.h"
+#include "ctlio/solvers/lio/pose_covariance.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
 #include "ctlio/solvers/lio/state_keys.h"
 #include "scan_clock.h"
@@ -248,19 +248,14 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 }
 
 void LioOdometry::ReportPoseCovariance(ScanResult* result) {
-  double* pose = window_.State(estimator_->NewestPoseKey());
-  // Sparse QR of the window's Jacobian (the default); a rank-deficient window gives no
-  // covariance (the scan then has none) rather than a pseudo-inverse.
-  ceres::Covariance covariance(ceres::Covariance::Options{});
-  const std::vector<std::pair<const double*, const double*>> blocks = {{pose, pose}};
-  if (!covariance.Compute(blocks, &window_.problem())) return;
-  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
-  if (!covariance.GetCovarianceBlockInTangentSpace(pose, pose, block.data())) return;
-  // The block's tangent δ_state = A·δ_body (T_mr ← T_mr·Exp(δ_body)), and T_mr·Exp(δ_body) =
-  // Exp(Ad(T_mr)·δ_body)·T_mr: ε = Ad(T_mr)·A⁻¹·δ_state (the GP knots' T_rm: A = −I; the
-  // baseline's T_wb: A = Ad(T_wb), so ε = δ_state).
-  const Mat6 M = result->T_mr.Adjoint() * estimator_->NewestPoseTangentFromBody().inverse();
-  result->pose_covariance = M * Mat6(block) * M.transpose();
+  // Not rescaled by the lidar term's own χ² (ScaledPoseCovariance, LidarChiSquareScale): on the
+  // tuning sequences that made the baseline 40x overconfident (docs/experiments/covariance.md).
+  // A rank-deficient window gives no covariance (the scan then has none).
+  const std::optional<Mat6> S =
+      PoseCovariance(&window_.problem(), window_.State(estimator_->NewestPoseKey()), result->T_mr,
+                     estimator_->NewestPoseTangentFromBody());
+  if (!S) return;
+  result->pose_covariance = *S;
   result->has_pose_covariance = true;
 }
 

@@ -9,6 +9,7 @@
 #include "ctlio/factors/lidar/point_to_plane_world.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
+#include "ctlio/solvers/lio/imu_midpoint.h"
 
 namespace ctlio::lio {
 
@@ -100,6 +101,7 @@ NavStateEstimator::State NavStateEstimator::AddNavState(double t, const SE3& T_w
 std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
                                                          double* max_gap) const {
   std::vector<ImuSegment> segments = imu_.Segments(t_a, t_b, max_gap, config_.input_imu);
+  InterpolateAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
   const Mat3 C_ri = config_.ImuPose(config_.input_imu).rotation();
   if (!C_ri.isIdentity(0.0)) {
     for (ImuSegment& seg : segments) {

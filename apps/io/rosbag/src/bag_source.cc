@@ -134,9 +134,9 @@ void BagSource::Impl::Open() {
     }
   }
   custom_msg = livox::IsCustomMsgLidar(topics, options.lidar_topic);
-  lidar_topic = PickTopic(topics, custom_msg ? livox::kCustomMsgType : kPointCloud2,
-                          options.lidar_topic, preset ? preset->lidar_topic : "", "lidar_topic",
-                          path);
+  lidar_topic =
+      PickTopic(topics, custom_msg ? livox::kCustomMsgType : kPointCloud2, options.lidar_topic,
+                preset ? preset->lidar_topic : "", "lidar_topic", path);
   imu_topic = PickTopic(topics, kImu, options.imu_topic, preset ? preset->imu_topic : "",
                         "imu_topic", path);
   if (preset) LOG(INFO) << path << ": preset " << preset->name << " (" << preset->note << ")";
@@ -144,7 +144,8 @@ void BagSource::Impl::Open() {
   // The frames of the first messages name the ends of the extrinsic (ChooseExtrinsic).
   stream->Select({lidar_topic});
   if (stream->Next()) {
-    lidar_frame = livox::ReadLidarMessage(*stream, custom_msg, Where(lidar_topic, 1)).header.frame_id;
+    lidar_frame =
+        livox::ReadLidarMessage(*stream, custom_msg, Where(lidar_topic, 1)).header.frame_id;
   }
   stream->Select({imu_topic});
   if (stream->Next()) {

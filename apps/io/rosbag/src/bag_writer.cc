@@ -45,11 +45,20 @@ nav_msgs::Odometry OdometryMsg(const StampedPose& p, const std::string& frame,
 
 }  // namespace
 
-void WriteOdometryMessages(const std::vector<StampedPose>& trajectory, const std::string& topic,
-                           const std::string& frame, const std::string& child_frame,
-                           BagMessageSink& sink) {
-  for (const StampedPose& p : trajectory) {
-    sink.Write(topic, p.t_ns, OdometryMsg(p, frame, child_frame));
+void WriteOdometryMessages(const std::vector<StampedPose>& trajectory,
+                           const std::vector<std::array<double, 36>>& pose_covariances,
+                           const std::string& topic, const std::string& frame,
+                           const std::string& child_frame, BagMessageSink& sink) {
+  if (!pose_covariances.empty() && pose_covariances.size() != trajectory.size()) {
+    throw std::invalid_argument(std::to_string(pose_covariances.size()) + " pose covariances for " +
+                                std::to_string(trajectory.size()) + " poses");
+  }
+  for (size_t k = 0; k < trajectory.size(); ++k) {
+    nav_msgs::Odometry o = OdometryMsg(trajectory[k], frame, child_frame);
+    if (!pose_covariances.empty()) {
+      for (size_t i = 0; i < 36; ++i) o.pose.covariance[i] = pose_covariances[k][i];
+    }
+    sink.Write(topic, trajectory[k].t_ns, o);
   }
 }
 

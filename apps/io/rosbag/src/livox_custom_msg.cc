@@ -5,9 +5,9 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "ctlio/io/bag_stream.h"
 #include "ctlio/io/driver_conventions.h"
 #include "ctlio/io/pointcloud2.h"
-#include "ctlio/io/bag_stream.h"
 #include "ctlio/io/ros_wire_check.h"
 
 namespace ctlio::io::livox {

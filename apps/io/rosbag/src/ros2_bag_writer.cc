@@ -70,23 +70,25 @@ size_t WriteRos2Bag(DataSource& source, const std::string& path, const RosbagWri
 }
 
 void WriteOdometryRos2Bag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                          const std::vector<std::array<double, 36>>& pose_covariances,
                           const std::string& topic, const std::string& frame,
                           const std::string& child_frame) {
   const auto writer =
       OpenRos2ContainerWriter(path, ros2::Ros2Storage::kMcap, ros2::Ros2Compression::kNone);
   Ros2Sink sink(writer.get());
-  WriteOdometryMessages(trajectory, topic, frame, child_frame, sink);
+  WriteOdometryMessages(trajectory, pose_covariances, topic, frame, child_frame, sink);
   writer->Close();
 }
 
-std::pair<std::string, std::string> WriteEstimateBag(const std::string& out_dir,
-                                                     const std::string& source_name,
-                                                     const std::vector<StampedPose>& trajectory) {
+std::pair<std::string, std::string> WriteEstimateBag(
+    const std::string& out_dir, const std::string& source_name,
+    const std::vector<StampedPose>& trajectory,
+    const std::vector<std::array<double, 36>>& pose_covariances) {
   if (source_name.rfind("ros2bag:", 0) == 0) {
-    WriteOdometryRos2Bag(out_dir + "/trajectory_bag", trajectory);
+    WriteOdometryRos2Bag(out_dir + "/trajectory_bag", trajectory, pose_covariances);
     return {out_dir + "/trajectory_bag", "the estimate as nav_msgs/Odometry (ROS 2 bag, MCAP)"};
   }
-  WriteOdometryBag(out_dir + "/trajectory.bag", trajectory);
+  WriteOdometryBag(out_dir + "/trajectory.bag", trajectory, pose_covariances);
   return {out_dir + "/trajectory.bag", "the estimate as nav_msgs/Odometry (ROS 1 bag)"};
 }
 

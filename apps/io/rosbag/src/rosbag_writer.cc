@@ -3,6 +3,7 @@
 #include <rosbag/bag.h>
 
 #include <stdexcept>
+#include <string>
 
 #include "ctlio/io/bag_writer.h"
 #include "ctlio/io/livox_custom_msg.h"
@@ -71,10 +72,23 @@ size_t WriteRosbag(DataSource& source, const std::string& path, const RosbagWrit
 void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
                       const std::string& topic, const std::string& frame,
                       const std::string& child_frame) {
+  WriteOdometryBag(path, trajectory, std::vector<std::array<double, 36>>(trajectory.size()), topic,
+                   frame, child_frame);
+}
+
+void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::vector<std::array<double, 36>>& pose_covariances,
+                      const std::string& topic, const std::string& frame,
+                      const std::string& child_frame) {
+  if (pose_covariances.size() != trajectory.size()) {
+    throw std::invalid_argument(path + ": " + std::to_string(pose_covariances.size()) +
+                                " pose covariances for " + std::to_string(trajectory.size()) +
+                                " poses");
+  }
   try {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
     Ros1Sink sink(&bag);
-    WriteOdometryMessages(trajectory, topic, frame, child_frame, sink);
+    WriteOdometryMessages(trajectory, pose_covariances, topic, frame, child_frame, sink);
     bag.close();
   } catch (const ros::Exception& e) {
     throw std::runtime_error(path + ": cannot write the bag: " + e.what());

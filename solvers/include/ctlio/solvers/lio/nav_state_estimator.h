@@ -77,8 +77,9 @@ class NavStateEstimator final : public Estimator {
   DeskewTable Deskew(const State& from, const State& to) const;
 
  private:
-  // The zero-order-hold signal of the input IMU (config.input_imu) over [t_a, t_b], rotated into
-  // the robot frame. Its lever arm is not modelled: ω̇×p would need the derivative of the gyro.
+  // The signal of the input IMU (config.input_imu) over [t_a, t_b] at the midpoints of the
+  // zero-order-hold segments (imu_midpoint.h), rotated into the robot frame. Its lever arm is not
+  // modelled: ω̇×p would need the derivative of the gyro.
   std::vector<ImuSegment> InputSegments(double t_a, double t_b, double* max_gap) const;
   State AddNavState(double t, const SE3& T_wb, const Vec3& v, const Vec6& bias,
                     SlidingWindow* window);

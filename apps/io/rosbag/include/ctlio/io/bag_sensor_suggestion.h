@@ -1,5 +1,5 @@
-// The sensor suggestion of sensor_suggestion.h for a bag (ROS 1 or ROS 2): its topics, the lidar topic's
-// type and first message (fields and points). Advisory: any error reading the bag gives no
+// The sensor suggestion of sensor_suggestion.h for a bag (ROS 1 or ROS 2): its topics, the lidar
+// topic's type and first message (fields and points). Advisory: any error reading the bag gives no
 // suggestion (the reader itself reports it).
 #pragma once
 

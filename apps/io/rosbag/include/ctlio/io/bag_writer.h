@@ -8,6 +8,7 @@
 // the order it hands them out.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -36,10 +37,13 @@ class BagMessageSink {
 // scans.
 size_t WriteBagMessages(DataSource& source, BagMessageSink& sink, const RosbagWriteOptions& options,
                         const std::function<void(size_t, size_t)>& progress = {});
-// A trajectory as nav_msgs/Odometry messages on `topic` (WriteOdometryBag's messages).
-void WriteOdometryMessages(const std::vector<StampedPose>& trajectory, const std::string& topic,
-                           const std::string& frame, const std::string& child_frame,
-                           BagMessageSink& sink);
+// A trajectory as nav_msgs/Odometry messages on `topic` (WriteOdometryBag's messages), each with
+// its pose.covariance (ROS row-major 6×6 over [x y z roll pitch yaw]; zeros when
+// `pose_covariances` is empty, else one per pose: std::invalid_argument otherwise).
+void WriteOdometryMessages(const std::vector<StampedPose>& trajectory,
+                           const std::vector<std::array<double, 36>>& pose_covariances,
+                           const std::string& topic, const std::string& frame,
+                           const std::string& child_frame, BagMessageSink& sink);
 
 // What the ROS 2 sink needs of a container writer: Ros2BagWriter's interface (ros2_bag.h), so that
 // tests can keep the messages in memory.
@@ -71,8 +75,9 @@ size_t WriteRos2Bag(DataSource& source, const std::string& path,
 size_t WriteRos2Bag(DataSource& source, Ros2ContainerWriter& writer,
                     const RosbagWriteOptions& options = {},
                     const std::function<void(size_t, size_t)>& progress = {});
-// WriteOdometryBag as a ROS 2 bag folder (MCAP).
+// WriteOdometryBag as a ROS 2 bag folder (MCAP); `pose_covariances` as WriteOdometryMessages.
 void WriteOdometryRos2Bag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                          const std::vector<std::array<double, 36>>& pose_covariances = {},
                           const std::string& topic = "/ctlio/odometry",
                           const std::string& frame = "map",
                           const std::string& child_frame = "os_lidar");

@@ -28,6 +28,7 @@
 // with a warning.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -146,12 +147,21 @@ void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& t
                       const std::string& topic = "/ctlio/odometry",
                       const std::string& frame = "map",
                       const std::string& child_frame = "os_lidar");
+// The same with each message's pose.covariance (ROS row-major 6×6 over [x y z roll pitch yaw];
+// one per pose; lioapp::RosPoseCovariance). Throws std::invalid_argument on a count mismatch.
+void WriteOdometryBag(const std::string& path, const std::vector<StampedPose>& trajectory,
+                      const std::vector<std::array<double, 36>>& pose_covariances,
+                      const std::string& topic = "/ctlio/odometry",
+                      const std::string& frame = "map",
+                      const std::string& child_frame = "os_lidar");
 
 // ctlio_odometry --write_bag: the estimate in `out_dir` as a bag of the input's kind — a ROS 2 bag
 // folder `trajectory_bag/` when `source_name` (DataSource::Name) is a ROS 2 bag's ("ros2bag:..."),
-// else the ROS 1 bag `trajectory.bag`. Returns the path and a description for the outputs list.
-std::pair<std::string, std::string> WriteEstimateBag(const std::string& out_dir,
-                                                     const std::string& source_name,
-                                                     const std::vector<StampedPose>& trajectory);
+// else the ROS 1 bag `trajectory.bag`; each pose with its covariance (WriteOdometryBag). Returns
+// the path and a description for the outputs list.
+std::pair<std::string, std::string> WriteEstimateBag(
+    const std::string& out_dir, const std::string& source_name,
+    const std::vector<StampedPose>& trajectory,
+    const std::vector<std::array<double, 36>>& pose_covariances);
 
 }  // namespace ctlio::io
