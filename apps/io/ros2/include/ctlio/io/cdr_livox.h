@@ -12,13 +12,6 @@
 
 namespace ctlio::io::ros2 {
 
-  std::vector<LivoxCustomPoint> points;
-  bool operator==(const livox::CustomMsg& o) const {
-    return header == o.header && timebase == o.timebase && point_num == o.point_num &&
-           lidar_id == o.lidar_id && rsvd == o.rsvd && points == o.points;
-  }
-};
-
 void DecodeCdr(const uint8_t* data, size_t size, const std::string& where, livox::CustomMsg* msg);
 std::vector<uint8_t> EncodeCdr(const livox::CustomMsg& msg, CdrEndian endian = CdrEndian::kLittle);
 
