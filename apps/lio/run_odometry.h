@@ -42,6 +42,8 @@ struct RunOptions {
   // warm-up (ScanResult::revised_scans > 0) hands over the replay's points, in the replayed map
   // frame of RunSummary::trajectory: a map starts over there (the warm-up's live points were
   // placed with the calibration the replay revised, a 3° extrinsic error puts them metres off).
+  // A replay adopted at the end of the input (replay_adopt_after_s past it) hands over nothing:
+  // the map stays the live one.
   std::function<void(const lio::ScanResult&, const std::vector<Vec3>&)> map_points;
 };
 
