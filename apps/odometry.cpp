@@ -120,6 +120,10 @@ DEFINE_double(play_rate, 0.0,
               "Give each scan to the odometry at its own time on the wall clock, sped up by this "
               "factor (1 = the sensor's pace, as rosbag play -r): the per-scan ms are then the "
               "latency from a sweep's arrival to its pose; 0 = back to back (the default)");
+DEFINE_double(warmup_replay_adopt_after_s, 60.0,
+              "The calibration warm-up replay runs on a second thread, adopted with the first "
+              "scan this many seconds of data after its span or at the end of the input; < 0: "
+              "inside the scan that reaches the span (the live output pauses for the replay)");
 DEFINE_int32(frontend_threads, 1,
              "Threads of the lidar front end (association, range gate): lidar_frontend.threads "
              "of the config unless given; same results as one thread");
@@ -386,6 +390,7 @@ int main(int argc, char** argv) {
       options.extrinsic_from_config = config_extrinsic;
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       options.play_rate = FLAGS_play_rate;
+      options.replay_adopt_after_s = FLAGS_warmup_replay_adopt_after_s;
       lioapp::ProgressReporter progress(std::cerr, lioapp::ProgressReporter::IsTerminal(2));
       progress.SetEventLimit(20, "scans.log has every scan's status and message");
       if (FLAGS_progress) {

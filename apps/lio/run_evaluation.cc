@@ -113,6 +113,9 @@ void WriteRunEvaluation(const RunSummary& run,
        << run.ate->max << "\nate_pairs " << run.ate->pairs << "\n";
     // calibration.warmup_replay_s: the live output's ATE, before the replay revised its start.
     ev << "warmup_replayed_scans " << run.warmup_replayed_scans << "\n";
+    // Its cost: CPU (its own thread's in the background) and the live output's wait for it.
+    ev << "warmup_replay_cpu_ms " << run.warmup_replay_cpu_ms << "\nwarmup_replay_wait_ms "
+       << run.warmup_replay_wait_ms << "\nwarmup_replay_scans " << run.warmup_replay_scans << "\n";
     if (run.live_ate) ev << "live_ate_rmse_m " << run.live_ate->rmse << "\n";
     if (!run.dense.empty()) {
       ev << "dense_ate_rmse_m " << EvaluateAte(run.dense, *truth).rmse << "\ndense_poses "

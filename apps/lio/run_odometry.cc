@@ -228,7 +228,9 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   }
   if (const auto g = source.Gravity()) config.gravity = *g;
   // The odometry applies the input gates (config.input); the runner only reports them.
-  auto odometry = std::make_unique<lio::CalibratingOdometry>(config);
+  auto odometry = std::make_unique<lio::CalibratingOdometry>(
+      config, lio::ReplaySchedule{options.replay_adopt_after_s >= 0.0,
+                                  std::max(0.0, options.replay_adopt_after_s)});
   odometry->SampleFinalTrajectory(options.trajectory_rate_hz);
   // T_mr first; T_imu_lidar at the end (below).
   const auto take_final = [&](const std::vector<std::pair<int64_t, SE3>>& samples) {
@@ -264,6 +266,27 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   io::ScanFrame frame;
   std::vector<double> ms;
   SE3 live_from_replay;  // identity until a calibration warm-up replay
+  // The calibration warm-up replay replaced the earlier scans' results: tally those instead
+  // (their live dense samples are gone with the pipeline that made them: the scan poses stand
+  // in; the final ones are the replay's, taken after).
+  const auto revise = [&](const lio::ScanResult& r) {
+    const std::deque<lio::ScanResult>& all = odometry->results();
+    ResetTally(&run);
+    for (size_t i = 0; i + 1 < all.size(); ++i) {
+      Tally(all[i], i, T_imu_lidar, &run);
+      if (all[i].status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
+        run.dense_live.push_back(run.trajectory.back());
+      }
+    }
+    run.warmup_replayed_scans = r.revised_scans;
+    run.warmup_live_scans.assign(odometry->warmup_results().begin(),
+                                 odometry->warmup_results().end());
+    if (const auto& cost = odometry->last_replay()) {
+      run.warmup_replay_cpu_ms = cost->cpu_ms;
+      run.warmup_replay_wait_ms = cost->wait_ms;
+      run.warmup_replay_scans = cost->scans;
+    }
+  };
   size_t done = 0;
   std::vector<int64_t> scan_ends;  // of the scans handed to the odometry, for the lidar gaps
   std::optional<std::pair<std::chrono::steady_clock::time_point, int64_t>> pace_origin;
@@ -329,22 +352,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
         options.map_points(r, *inserted);
       }
     }
-    if (r.revised_scans > 0) {
-      // The calibration warm-up replay replaced the earlier scans' results: tally those instead
-      // (their live dense samples are gone with the pipeline that made them: the scan poses stand
-      // in; the final ones are the replay's, taken below).
-      const std::deque<lio::ScanResult>& all = odometry->results();
-      ResetTally(&run);
-      for (size_t i = 0; i + 1 < all.size(); ++i) {
-        Tally(all[i], i, T_imu_lidar, &run);
-        if (all[i].status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
-          run.dense_live.push_back(run.trajectory.back());
-        }
-      }
-      run.warmup_replayed_scans = r.revised_scans;
-      run.warmup_live_scans.assign(odometry->warmup_results().begin(),
-                                   odometry->warmup_results().end());
-    }
+    if (r.revised_scans > 0) revise(r);
     Tally(r, done - 1, T_imu_lidar, &run);
     if (r.status != lio::ScanStatus::kFailed && options.trajectory_rate_hz > 0.0) {
       const SE3& T_rl = r.calibration.has_extrinsic ? r.calibration.T_imu_lidar : T_imu_lidar;
@@ -354,6 +362,13 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     take_final(odometry->TakeFinalTrajectory());
     if (options.progress) options.progress(done, total, r);
+  }
+  if (const auto r = odometry->Finish()) {
+    // A background warm-up replay not adopted before the input ended: its estimates, not a live
+    // output (no latency, no live pose).
+    revise(*r);
+    Tally(*r, done - 1, T_imu_lidar, &run);
+    take_final(odometry->TakeFinalTrajectory());
   }
   take_final(odometry->FinalTrajectoryTail());  // the window's estimates are final now
   // The extrinsic is one static state: its final estimate for every pose (each scan's own

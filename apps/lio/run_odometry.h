@@ -32,6 +32,10 @@ struct RunOptions {
   // ScanResult::milliseconds is then the latency from a sweep's arrival to its pose, with the
   // idle time between sweeps what a robot has (window.overlap uses it). 0: back to back.
   double play_rate = 0.0;
+  // The calibration warm-up replay (lio::ReplaySchedule, calibrating_odometry.h): on a second
+  // thread, adopted with the first scan ending replay_adopt_after_s after the span or at the end
+  // of the input, so that the live output does not pause for it; < 0: inside the scan.
+  double replay_adopt_after_s = 60.0;
   // Called after every scan with (scans done, scans total or 0, the scan's result).
   std::function<void(size_t, size_t, const lio::ScanResult&)> progress;
   // Called after every scan not failed that inserted points into the odometry's voxel map, with
@@ -40,6 +44,8 @@ struct RunOptions {
   // warm-up (ScanResult::revised_scans > 0) hands over the replay's points, in the replayed map
   // frame of RunSummary::trajectory: a map starts over there (the warm-up's live points were
   // placed with the calibration the replay revised, a 3° extrinsic error puts them metres off).
+  // A replay adopted at the end of the input (replay_adopt_after_s past it) hands over nothing:
+  // the map stays the live one.
   std::function<void(const lio::ScanResult&, const std::vector<Vec3>&)> map_points;
 };
 
@@ -67,6 +73,10 @@ struct RunSummary {
   // (0: none), and the trajectory as returned live, scan by scan, before the replay revised its
   // start (the same as `trajectory` without a replay) with its ATE.
   int warmup_replayed_scans = 0;
+  // Its cost (CalibratingOdometry::last_replay): CPU on whichever thread ran it, the live
+  // thread's wait for it, the scans it processed (passes × span + the catch-up).
+  double warmup_replay_cpu_ms = 0.0, warmup_replay_wait_ms = 0.0;
+  int warmup_replay_scans = 0;
   std::vector<io::StampedPose> live_trajectory;
   std::vector<lio::ScanResult> warmup_live_scans;  // the replaced results, as returned live
   std::optional<AteResult> live_ate;

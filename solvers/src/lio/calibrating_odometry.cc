@@ -2,17 +2,19 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "scan_clock.h"
+#include "warmup_replay_worker.h"
 
 namespace ctlio::lio {
 
 using internal::AddNote;
 using internal::MsSince;
-using internal::ThreadCpuMs;
 
 namespace {
 
@@ -29,14 +31,6 @@ OdometryConfig SinglePass(OdometryConfig config) {
   cal.warmup_replay_hold = false;
   cal.warmup_replay_freeze = false;
   return config;
-}
-
-// A pipeline inside this one: the history is CalibratingOdometry's, so it keeps one result.
-std::unique_ptr<LioOdometry> MakePipeline(OdometryConfig config, double trajectory_rate_hz) {
-  config.kept_results = 1;
-  auto pipeline = std::make_unique<LioOdometry>(config);
-  pipeline->SampleFinalTrajectory(trajectory_rate_hz);
-  return pipeline;
 }
 
 }  // namespace
@@ -85,10 +79,15 @@ ScanResult::CalibrationEstimate FrozenCalibration(const ScanResult::CalibrationE
   return frozen;
 }
 
-CalibratingOdometry::CalibratingOdometry(const OdometryConfig& config)
+CalibratingOdometry::CalibratingOdometry(const OdometryConfig& config, ReplaySchedule schedule)
     : config_(Validated(config)),
-      pipeline_(MakePipeline(SinglePass(config), 0.0)),
-      keeping_(config.calibration.replays_warmup()) {}
+      schedule_(schedule),
+      pipeline_(internal::MakeReplayPipeline(SinglePass(config), 0.0)),
+      keeping_(config.calibration.replays_warmup()) {
+  if (!(schedule_.adopt_after_s >= 0.0)) {
+    throw std::invalid_argument("CalibratingOdometry: ReplaySchedule::adopt_after_s must be >= 0");
+  }
+}
 
 CalibratingOdometry::~CalibratingOdometry() = default;
 
@@ -102,17 +101,30 @@ bool CalibratingOdometry::AddImu(const ImuSample& sample) {
   // Kept as given, rejected or not: the replay's own buffer applies the same gates again. A
   // sample the pipeline threw on (out of order, an undeclared IMU) is not kept.
   if (keeping_) warmup_imu_.push_back(sample);
+  if (background_) background_->Push(sample);
   return added;
 }
 
 ScanResult CalibratingOdometry::AddScan(const LidarScan& scan) {
   ScanResult result = pipeline_->AddScan(scan);  // throws on a bad scan: nothing kept then
   if (frozen_) result.calibration = *frozen_;
-  const bool keeping = keeping_;
-  if (keeping) warmup_scans_.emplace_back(scan, warmup_imu_.size());
-  // A pending replay replaces every result of its span: those stay until it has run.
-  Record(result, !keeping);
-  if (keeping) MaybeReplay(&result);
+  if (background_) {
+    background_->Push(scan);
+    ++background_scans_;
+  }
+  if (keeping_) warmup_scans_.emplace_back(scan, warmup_imu_.size());
+  // A pending replay replaces every result of its span (and of the catch-up): those stay until
+  // it is adopted.
+  Record(result, !keeping_ && !background_);
+  if (keeping_) MaybeReplay(&result);
+  if (background_ && scan.end_ns >= adopt_ns_) AdoptBackground(&result);
+  return result;
+}
+
+std::optional<ScanResult> CalibratingOdometry::Finish() {
+  if (!background_) return std::nullopt;
+  ScanResult result = results_.back();
+  AdoptBackground(&result);
   return result;
 }
 
@@ -141,76 +153,78 @@ void CalibratingOdometry::MaybeReplay(ScanResult* result) {
 }
 
 void CalibratingOdometry::Replay(double span, ScanResult* result) {
-  const auto start = std::chrono::steady_clock::now();
-  const double cpu_start = ThreadCpuMs();
   const CalibrationOptions& options = config_.calibration;
-  // Each pass starts from the estimates the one before ended with (the live ones for the first).
-  const int passes = options.warmup_replay_passes;
-  std::unique_ptr<LioOdometry> replay;
-  OdometryConfig replay_config;
-  std::optional<ScanResult::CalibrationEstimate> frozen;
-  std::deque<ScanResult> replayed_results;
-  ScanResult replayed;
-  ScanResult::CalibrationEstimate start_values = result->calibration;
-  for (int pass = 0; pass < passes; ++pass) {
-    const bool last = pass == passes - 1;
-    replay_config = ReplayConfig(config_, start_values);
-    const bool hold = last && options.warmup_replay_hold;
-    if (hold) replay_config.calibration.hold_gravity = true;
-    frozen.reset();
-    if (last && options.warmup_replay_freeze) {
-      // ReplayConfig has put the values into the configuration: known values from here on.
-      replay_config.calibration.estimate_time_offset = false;
-      replay_config.calibration.estimate_extrinsic = false;
-      frozen = FrozenCalibration(start_values, replay_config);
-    }
-    replay = MakePipeline(replay_config, trajectory_rate_hz_);
-    if (hold) {
-      // The replay's clock starts at the first kept scan's begin, so its scans end within span.
-      std::vector<bool> observable = start_values.unobservable;
-      observable.flip();  // empty (no check): all
-      replay->HoldCalibrationUntil(span, std::move(observable));
-    }
-    replayed_results.clear();
-    size_t next_imu = 0;
-    for (const auto& [scan, imu_before] : warmup_scans_) {
-      for (; next_imu < imu_before; ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
-      replayed = replay->AddScan(scan);
-      if (frozen) replayed.calibration = *frozen;
-      replayed_results.push_back(replayed);
-    }
-    for (; next_imu < warmup_imu_.size(); ++next_imu) replay->AddImu(warmup_imu_[next_imu]);
-    // A pass that ends without an estimate is the one that carries on: nothing to start from.
-    if (replayed.status == ScanStatus::kFailed || !replay->initialised()) break;
-    start_values = replayed.calibration;
-  }
-  // This call's cost is the live scan's and the whole replay's.
-  replayed.revised_scans = static_cast<int>(warmup_scans_.size()) - 1;
-  replayed.milliseconds = result->milliseconds + MsSince(start);
-  replayed.cpu_ms = result->cpu_ms + ThreadCpuMs() - cpu_start;
+  internal::WarmupSpan kept{std::move(warmup_imu_), std::move(warmup_scans_)};
+  warmup_scans_ = {};
+  warmup_imu_ = {};
+  keeping_ = false;
   std::ostringstream note;
-  note << "calibration warm-up replayed: " << warmup_scans_.size() << " scans over " << span
-       << " s processed again from the estimates after this scan";
+  note << "calibration warm-up replayed: " << kept.scans.size() << " scans over " << span
+       << " s processed again from the estimates after "
+       << (schedule_.background ? "scan " + std::to_string(results_.size() - 1) : "this scan");
+  const int passes = options.warmup_replay_passes;
   if (passes > 1) note << " (" << passes << " passes, each from the previous one's estimates)";
   if (options.warmup_replay_hold) note << ", the calibration held over the span";
   if (options.warmup_replay_freeze) {
     note << ", the calibration frozen at the values the "
          << (passes > 1 ? "pass before" : "live run") << " ended with";
   }
-  AddNote(&replayed, note.str());
-  replayed_results.back() = replayed;
+  background_scans_ = kept.scans.size() * static_cast<size_t>(passes);
+  if (schedule_.background) {
+    adopt_ns_ = kept.scans.back().first.end_ns +
+                static_cast<int64_t>(std::llround(1e9 * schedule_.adopt_after_s));
+    note << ", on a second thread, adopted with the first scan ending " << schedule_.adopt_after_s
+         << " s later (or at the end of the input)";
+    replay_note_ = note.str();
+    background_ = std::make_unique<internal::BackgroundReplay>(
+        config_, trajectory_rate_hz_, std::move(kept), span, result->calibration);
+    AddNote(result, "calibration warm-up replay started on a second thread");
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  internal::ReplayedPipeline replayed =
+      internal::ReplayWarmup(config_, trajectory_rate_hz_, kept, span, result->calibration);
+  Adopt(std::move(replayed), MsSince(start), note.str(), result);
+}
+
+void CalibratingOdometry::AdoptBackground(ScanResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<internal::BackgroundReplay> background = std::move(background_);
+  internal::ReplayedPipeline replayed;
+  try {
+    replayed = background->Finish();
+  } catch (const std::exception& e) {
+    // The live pipeline carries on, as when the warm-up was never estimated.
+    AddNote(result, std::string("calibration warm-up replay failed, not adopted: ") + e.what());
+    results_.back().message = result->message;
+    if (config_.kept_results > 0) {
+      while (results_.size() > config_.kept_results) results_.pop_front();
+    }
+    return;
+  }
+  Adopt(std::move(replayed), MsSince(start), replay_note_, result);
+}
+
+void CalibratingOdometry::Adopt(internal::ReplayedPipeline replayed, double wait_ms,
+                                const std::string& note, ScanResult* result) {
+  // This scan's cost is the live scan's and the replay's (its CPU on whichever thread ran it, the
+  // live thread's wait for it).
+  ScanResult adopted = replayed.results.back();
+  adopted.revised_scans = static_cast<int>(replayed.results.size()) - 1;
+  adopted.milliseconds = result->milliseconds + wait_ms;
+  adopted.cpu_ms = result->cpu_ms + replayed.cpu_ms;
+  AddNote(&adopted, note);
+  replayed.results.back() = adopted;
+  last_replay_ = ReplayCost{replayed.cpu_ms, wait_ms, static_cast<int>(background_scans_)};
   // The swap: the replayed pipeline, its config (the caller's result bound), its results.
   const size_t kept = config_.kept_results;
-  config_ = replay_config;
+  config_ = replayed.config;
   config_.kept_results = kept;
   warmup_results_ = std::move(results_);
-  results_ = std::move(replayed_results);
-  warmup_scans_ = {};
-  warmup_imu_ = {};
-  keeping_ = false;
-  frozen_ = frozen;
-  pipeline_ = std::move(replay);
-  *result = replayed;
+  results_ = std::move(replayed.results);
+  frozen_ = replayed.frozen;
+  pipeline_ = std::move(replayed.pipeline);
+  *result = adopted;
 }
 
 }  // namespace ctlio::lio

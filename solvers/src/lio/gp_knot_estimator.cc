@@ -17,6 +17,7 @@
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/manifolds/rotation_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
+#include "ctlio/solvers/lio/calibration_blocks.h"
 #include "ctlio/solvers/lio/continuous_lidar_term.h"
 #include "ctlio/solvers/lio/imu_knot_prediction.h"
 
@@ -193,16 +194,8 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
     }
   }
   if (estimates_extrinsic()) {
-    // T_rl: a static state with the Gaussian prior of the config (mean T_imu_lidar, σ per
-    // rotation and translation axis, left perturbation as PoseManifold: [ρ; φ]).
-    extrinsic_ = window->AddPoseState(kExtrinsicKey, config_.T_imu_lidar);
-    const CalibrationOptions& c = config_.calibration;
-    Vec6 sigma;
-    sigma << Vec3::Constant(c.extrinsic_prior_sigma_m),
-        Vec3::Constant(c.extrinsic_prior_sigma_deg * M_PI / 180.0);
-    window->AddResidualBlock(
-        new PosePrior(config_.T_imu_lidar, sigma.cwiseInverse().asDiagonal().toDenseMatrix()),
-        nullptr, {kExtrinsicKey});
+    // T_rl: a static state with the Gaussian prior of the config (calibration_blocks.h).
+    extrinsic_ = AddExtrinsicState(config_, window);
   }
   knots_.push_back(AddKnot(scan.t_end, SE3(), Vec6::Zero(), Vec6::Zero(),
                            std::vector<Vec6>(num_imus(), Vec6::Zero()), window));
@@ -218,14 +211,8 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
       // Samples stamped up to t_0 − δ_j measure the state before the first knot.
       last_stamp_.push_back(scan.t_end - cal.TimeOffset(j));
       if (!cal.estimate_time_offset) continue;
-      // δ_j: a static 1-D state with its prior N(δ̄_j, σ²), added once (the marginal priors
-      // carry its information on when knots leave).
-      const Eigen::VectorXd mean = Eigen::VectorXd::Constant(1, cal.TimeOffset(j));
-      window->AddVectorState(TimeOffsetKey(j), mean);
-      window->AddResidualBlock(
-          new EuclideanPrior<1>(Eigen::Matrix<double, 1, 1>(mean[0]),
-                                Eigen::Matrix<double, 1, 1>(1.0 / cal.time_offset_prior_sigma_s)),
-          nullptr, {TimeOffsetKey(j)});
+      // δ_j: a static 1-D state with its prior, added once (calibration_blocks.h).
+      AddTimeOffsetState(cal, j, window);
     }
   }
 }

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "ctlio/factors/gp/vector_prior.h"
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
 #include "ctlio/factors/lidar/point_to_plane_world.h"
+#include "ctlio/factors/lidar/point_to_plane_world_calibrated.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
+#include "ctlio/solvers/lio/calibration_blocks.h"
 #include "ctlio/solvers/lio/imu_midpoint.h"
 
 namespace ctlio::lio {
@@ -33,41 +36,92 @@ imu::NavState ReadNavState(const NavStateEstimator::State& s) {
 }
 
 // The keypoints deskewed into the body frame at the scan end by the IMU integrated from the
-// previous state's current estimate (re-integrated every round), at the single pose T_wb.
+// previous state's current estimate (re-integrated every round), at the single pose T_wb. With
+// online calibration each keypoint enters from the lidar frame through T_rl, and the state is
+// carried ε = δ̄ − δ along the body twist to the scan end (PointToPlaneWorldCalibrated).
 class DeskewedLidarTerm final : public LidarTerm {
  public:
   DeskewedLidarTerm(const NavStateEstimator& estimator, const NavStateEstimator::State& prev,
-                    const NavStateEstimator::State& s, const std::vector<TimedPoint>& keypoints)
-      : estimator_(estimator), prev_(prev), s_(s), keypoints_(keypoints) {}
+                    const NavStateEstimator::State& s, const PreparedScan& scan)
+      : estimator_(estimator),
+        prev_(prev),
+        s_(s),
+        keypoints_(scan.keypoints),
+        calibrated_(estimator.config().calibration.any()) {
+    if (!calibrated_) return;
+    // The lidar-frame points (prepared with the extrinsic estimate of the scan's start).
+    const SE3 T_lidar_robot = scan.T_robot_lidar.Inverse();
+    q_l_.reserve(keypoints_.size());
+    for (const TimedPoint& k : keypoints_) q_l_.push_back(T_lidar_robot * k.point);
+    deskew_.resize(keypoints_.size());
+  }
 
   size_t num_keypoints() const override { return keypoints_.size(); }
   void BeginRound() override {
     table_ = estimator_.Deskew(prev_, s_);
     T_wb_ = PoseManifold::Pose(s_.pose);
+    if (!calibrated_) return;
+    T_rl_ = estimator_.Extrinsic();
+    geometry_.twist = table_.EndTwist();
+    geometry_.offset_anchor = s_.offset;
+    T_wb_ = T_wb_ * SE3::Exp((s_.offset - estimator_.TimeOffset()) * geometry_.twist);
   }
   void Locate(size_t i, Vec3* q, Vec3* p_map) override {
-    *q = table_.ToEnd(keypoints_[i].time, keypoints_[i].point);
+    if (calibrated_) {
+      deskew_[i] = table_.T_end_inv * table_.Interpolate(keypoints_[i].time);
+      *q = deskew_[i] * (T_rl_ * q_l_[i]);
+    } else {
+      *q = table_.ToEnd(keypoints_[i].time, keypoints_[i].point);
+    }
     *p_map = T_wb_ * *q;
   }
   ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& association,
                                      ceres::LossFunction* loss, SlidingWindow* window) override {
+    if (calibrated_) {
+      if (calibrated_costs_.empty()) calibrated_costs_.resize(keypoints_.size(), nullptr);
+      const bool extrinsic = estimator_.estimates_extrinsic();
+      const bool offset = estimator_.estimates_time_offset();
+      calibrated_costs_[i] = new PointToPlaneWorldCalibrated(association, q_l_[i], Geometry(i),
+                                                             extrinsic, offset, T_rl_);
+      std::vector<StateId> blocks = {s_.keys.pose};
+      if (extrinsic) blocks.push_back(kExtrinsicKey);
+      if (offset) blocks.push_back(TimeOffsetKey(estimator_.config().input_imu));
+      return window->AddResidualBlock(calibrated_costs_[i], loss, blocks);
+    }
     if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
     costs_[i] = new PointToPlaneWorld(association);
     return window->AddResidualBlock(costs_[i], loss, {s_.keys.pose});
   }
   void UpdateResidual(size_t i, const PlaneAssociation& association) override {
-    costs_[i]->set_association(association);
+    if (calibrated_) {
+      calibrated_costs_[i]->Update(association, Geometry(i));
+    } else {
+      costs_[i]->set_association(association);
+    }
   }
   SE3 NewestPose() const override { return PoseManifold::Pose(s_.pose); }
 
  private:
+  PointToPlaneWorldCalibrated::Geometry Geometry(size_t i) const {
+    PointToPlaneWorldCalibrated::Geometry g = geometry_;
+    g.deskew = deskew_[i];
+    return g;
+  }
+
   const NavStateEstimator& estimator_;
   NavStateEstimator::State prev_, s_;
   const std::vector<TimedPoint>& keypoints_;
   NavStateEstimator::DeskewTable table_;
-  SE3 T_wb_;
+  SE3 T_wb_;  // with calibration: carried to the scan end by Exp(ε·ξ)
   // Per keypoint: its residual's cost function (owned by the window), for UpdateResidual.
   std::vector<PointToPlaneWorld*> costs_;
+  // Online calibration: the lidar-frame points, this round's T_rl, twist and per-point deskew.
+  const bool calibrated_;
+  std::vector<Vec3> q_l_;
+  std::vector<SE3> deskew_;
+  SE3 T_rl_;
+  PointToPlaneWorldCalibrated::Geometry geometry_;
+  std::vector<PointToPlaneWorldCalibrated*> calibrated_costs_;
 };
 
 }  // namespace
@@ -84,8 +138,33 @@ SE3 NavStateEstimator::DeskewTable::Interpolate(double tau) const {
   return SE3::Exp(s * xi) * T_wb[i];
 }
 
+Vec6 NavStateEstimator::DeskewTable::EndTwist() const {
+  const size_t n = t.size();
+  if (n < 2) return Vec6::Zero();
+  const double dt = std::max(t[n - 1] - t[n - 2], 1e-12);
+  return (T_wb[n - 2].Inverse() * T_wb[n - 1]).Log() / dt;
+}
+
 NavStateEstimator::NavStateEstimator(const OdometryConfig& config, const ImuBuffer& imu)
-    : config_(config), imu_(imu) {}
+    : config_(config), imu_(imu) {
+  if (config_.calibration.estimate_time_offset && config_.num_imus() > 1) {
+    throw std::invalid_argument(
+        "calibration.estimate_time_offset: the IMU-as-input baseline estimates the clock offset "
+        "of one IMU; this config has " +
+        std::to_string(config_.num_imus()));
+  }
+}
+
+SE3 NavStateEstimator::Extrinsic() const {
+  return estimates_extrinsic() && window_ != nullptr ? window_->Pose(kExtrinsicKey)
+                                                     : config_.T_imu_lidar;
+}
+
+double NavStateEstimator::TimeOffset() const {
+  return estimates_time_offset() && window_ != nullptr
+             ? window_->State(TimeOffsetKey(config_.input_imu))[0]
+             : config_.calibration.TimeOffset(config_.input_imu);
+}
 
 NavStateEstimator::State NavStateEstimator::AddNavState(double t, const SE3& T_wb, const Vec3& v,
                                                         const Vec6& bias, SlidingWindow* window) {
@@ -112,17 +191,20 @@ std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
   return segments;
 }
 
-NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end) const {
+NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end,
+                                                            double to_offset) const {
   DeskewTable table;
   const Vec6 bias = Eigen::Map<const Vec6>(from.bias);
   imu::PreintegratedImu pim(bias, InputNoise(config_));
   const imu::NavState start = ReadNavState(from);
-  table.t.push_back(from.t);
+  // On the IMU clock from the state `from` to t_end − to_offset, listed on the lidar clock.
+  const double from_imu = from.t - from.offset;
+  table.t.push_back(from_imu + to_offset);
   table.T_wb.push_back(PoseManifold::Pose(from.pose));
-  for (const ImuSegment& seg : InputSegments(from.t, t_end, nullptr)) {
+  for (const ImuSegment& seg : InputSegments(from_imu, t_end - to_offset, nullptr)) {
     pim.Integrate(seg.accel, seg.gyro, seg.dt);
     const imu::NavState x = pim.Predict(start, bias, gravity_map_);
-    table.t.push_back(seg.t_begin + seg.dt);
+    table.t.push_back(seg.t_begin + seg.dt + to_offset);
     table.T_wb.push_back(SE3(x.C, x.p));
   }
   table.T_end_inv = table.T_wb.back().Inverse();
@@ -130,7 +212,7 @@ NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, d
 }
 
 NavStateEstimator::DeskewTable NavStateEstimator::Deskew(const State& from, const State& to) const {
-  if (!to.after_gap) return Integrate(from, to.t);
+  if (!to.after_gap) return Integrate(from, to.t, to.offset);
   DeskewTable table;
   table.t = {from.t, to.t};
   table.T_wb = {PoseManifold::Pose(from.pose), PoseManifold::Pose(to.pose)};
@@ -162,6 +244,7 @@ void NavStateEstimator::AddStateAcrossGap(const State& prev, double t_end, Slidi
   states_.push_back(AddNavState(t_end, T_pred, v, bias, window));
   State& s = states_.back();
   s.after_gap = true;
+  s.offset = TimeOffset();
   // v_s − v_prev ~ N(0, q·Δt·I): VectorGpPrior with Φ = I (a random walk on the velocity).
   const Mat3 sqrt_info = Mat3::Identity() / std::sqrt(config_.gap_velocity_walk * dt);
   window->AddResidualBlock(new gp::VectorGpPrior<3>(Mat3::Identity(), sqrt_info), nullptr,
@@ -173,7 +256,7 @@ SE3 NavStateEstimator::NewestPose() const { return PoseManifold::Pose(states_.ba
 
 std::vector<SE3> NavStateEstimator::PosesSincePrevious(const std::vector<double>& t) const {
   const State& s = states_.back();
-  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t);
+  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t, s.offset);
   const SE3 T_wb_end = PoseManifold::Pose(s.pose) * table.T_end_inv;
   std::vector<SE3> poses;
   poses.reserve(t.size());
@@ -250,6 +333,11 @@ void NavStateEstimator::Report(ScanResult* result) const {
   result->velocity.head<3>() = T_wb.rotation().transpose() * Eigen::Map<const Vec3>(s.velocity);
   result->velocity.tail<3>().setZero();
   result->bias = Eigen::Map<const Vec6>(s.bias);
+  if (estimates_time_offset()) result->calibration.time_offset_s = {TimeOffset()};
+  if (estimates_extrinsic()) {
+    result->calibration.has_extrinsic = true;
+    result->calibration.T_imu_lidar = Extrinsic();
+  }
 }
 
 void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
@@ -258,7 +346,12 @@ void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
   // map origin at rest, held constant (which fixes the gauge); its biases are free under the
   // initial bias prior, as in Singer-LIO.
   gravity_map_ = C_mi * Vec3(0, 0, -config_.gravity);
+  // The calibration states and their priors, as Singer-LIO's (calibration_blocks.h).
+  window_ = window;
+  if (estimates_extrinsic()) AddExtrinsicState(config_, window);
+  if (estimates_time_offset()) AddTimeOffsetState(config_.calibration, config_.input_imu, window);
   states_.push_back(AddNavState(scan.t_end, SE3(), Vec3::Zero(), Vec6::Zero(), window));
+  states_.back().offset = TimeOffset();
   const State& s = states_.back();
   window->SetStateConstant(s.keys.pose, true);
   window->SetStateConstant(s.keys.velocity, true);
@@ -269,7 +362,10 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
                                  ScanResult* result) {
   const State prev = states_.back();
   double max_gap = 0.0;
-  const std::vector<ImuSegment> segments = InputSegments(prev.t, scan.t_end, &max_gap);
+  // On the IMU clock: from the previous state to this scan's end at the current offset estimate.
+  const double offset = TimeOffset();
+  const std::vector<ImuSegment> segments =
+      InputSegments(prev.t - prev.offset, scan.t_end - offset, &max_gap);
   if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.gap_hold_max)) {
     AddStateAcrossGap(prev, scan.t_end, window);
     result->imu_residuals = 0;
@@ -284,6 +380,7 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
   for (const ImuSegment& seg : segments) pim.Integrate(seg.accel, seg.gyro, seg.dt);
   const imu::NavState pred = pim.Predict(ReadNavState(prev), bias_hat, gravity_map_);
   states_.push_back(AddNavState(scan.t_end, SE3(pred.C, pred.p), pred.v, bias_hat, window));
+  states_.back().offset = offset;
   const State& s = states_.back();
   window->AddResidualBlock(
       new imu::PreintegratedImuFactor(pim, gravity_map_), nullptr,
@@ -296,15 +393,24 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
 std::unique_ptr<LidarTerm> NavStateEstimator::MakeLidarTerm(const PreparedScan& scan,
                                                             SlidingWindow*) const {
   return std::make_unique<DeskewedLidarTerm>(*this, states_[states_.size() - 2], states_.back(),
-                                             scan.keypoints);
+                                             scan);
 }
 
 void NavStateEstimator::MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const {
   const State& s = states_.back();
   const DeskewTable table = Deskew(states_[states_.size() - 2], s);
-  const SE3 T_wb = PoseManifold::Pose(s.pose);
+  SE3 T_wb = PoseManifold::Pose(s.pose);
   out->clear();
   out->reserve(scan.points.size());
+  if (config_.calibration.any()) {
+    // The final calibration estimates: the points moved with T_rl, the state to the scan end.
+    T_wb = T_wb * SE3::Exp((s.offset - TimeOffset()) * table.EndTwist());
+    const SE3 recalibrate = Extrinsic() * scan.T_robot_lidar.Inverse();
+    for (const TimedPoint& p : scan.points) {
+      out->push_back(T_wb * table.ToEnd(p.time, recalibrate * p.point));
+    }
+    return;
+  }
   for (const TimedPoint& p : scan.points) out->push_back(T_wb * table.ToEnd(p.time, p.point));
 }
 

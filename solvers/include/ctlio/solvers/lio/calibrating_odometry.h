@@ -11,12 +11,18 @@
 // scan, the kept data are dropped with a note and the live pipeline carries on.
 //
 //   AddScan ─▶ pipeline ─▶ [keep the span] ─▶ span reached, estimated? ─▶ replay passes ─▶ swap
+//
+// Where the passes run is ReplaySchedule's: inside the scan that reached the span (the live
+// output pauses for all of them), or on a second thread while the live pipeline carries on, the
+// replayed one catching up on the scans that arrive meanwhile and swapped in at a scan fixed by
+// the data (warmup_replay_worker.h), so that what is adopted does not depend on thread timing.
 #pragma once
 
 #include <cstddef>
 #include <deque>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -24,10 +30,29 @@
 
 namespace ctlio::lio {
 
+namespace internal {
+class BackgroundReplay;
+struct ReplayedPipeline;
+}  // namespace internal
+
+// When the warm-up replay runs and when its pipeline replaces the live one.
+struct ReplaySchedule {
+  // false: the passes run inside the AddScan of the scan that reached the span, whose result is
+  // then the replay's (the live output pauses for the whole replay). true: on a second thread,
+  // while the live pipeline processes the scans that follow; the replayed pipeline processes them
+  // too, after its passes, and is adopted with the first scan that ends adopt_after_s or more
+  // after the one that reached the span (seconds of data: the same scan on every run). There the
+  // live thread waits for it if it is late (last_replay().wait_ms); Finish adopts it at the end of
+  // the input if that comes first. From the adopting scan on, the results are those of the
+  // replay inside the scan that reached the span, bit for bit; before it, the live pipeline's.
+  bool background = false;
+  double adopt_after_s = 60.0;
+};
+
 class CalibratingOdometry {
  public:
   // Throws std::invalid_argument naming the field for an invalid config (OdometryConfig::Validate).
-  explicit CalibratingOdometry(const OdometryConfig& config);
+  explicit CalibratingOdometry(const OdometryConfig& config, ReplaySchedule schedule = {});
   ~CalibratingOdometry();
   CalibratingOdometry(const CalibratingOdometry&) = delete;
   CalibratingOdometry& operator=(const CalibratingOdometry&) = delete;
@@ -49,6 +74,21 @@ class CalibratingOdometry {
   const std::deque<ScanResult>& warmup_results() const { return warmup_results_; }
   // True while the warm-up's data are kept for a replay.
   bool keeps_warmup() const { return keeping_; }
+  // True while a background replay runs or waits to be adopted.
+  bool replay_pending() const { return background_ != nullptr; }
+  // The end of the input: a pending background replay is adopted (waiting for it to catch up on
+  // every scan given) and the newest scan's result as replayed returned, as AddScan returns the
+  // adopting scan's (revised_scans > 0); nothing otherwise.
+  std::optional<ScanResult> Finish();
+
+  // The replay's cost, once adopted: its CPU (the passes and the catch-up, on whichever thread),
+  // the live thread's wait for it (the whole replay when not in the background) and the scans it
+  // processed (passes × span + catch-up).
+  struct ReplayCost {
+    double cpu_ms = 0.0, wait_ms = 0.0;
+    int scans = 0;
+  };
+  const std::optional<ReplayCost>& last_replay() const { return last_replay_; }
 
   // The pipeline that processes the next scan (after a replay, the replayed one). It keeps only
   // its newest result; the history is results().
@@ -81,11 +121,18 @@ class CalibratingOdometry {
   // replays them (Replay); gives up (note, data dropped) if twice the span passes without an
   // estimate.
   void MaybeReplay(ScanResult* result);
-  // The passes over the kept data, the swap, and `result` replaced by the replay's.
+  // The passes over the kept data, here or (ReplaySchedule::background) started on a second
+  // thread.
   void Replay(double span_s, ScanResult* result);
+  // The background replay's wait and swap, with `result` (the live one of the adopting scan).
+  void AdoptBackground(ScanResult* result);
+  // The swap: the replayed pipeline carries on; `result` becomes its result for the same scan.
+  void Adopt(internal::ReplayedPipeline replayed, double wait_ms, const std::string& note,
+             ScanResult* result);
   void Record(const ScanResult& result, bool bounded);
 
   OdometryConfig config_;
+  ReplaySchedule schedule_;
   double trajectory_rate_hz_ = 0.0;
   std::unique_ptr<LioOdometry> pipeline_;
   std::deque<ScanResult> results_;
@@ -97,6 +144,12 @@ class CalibratingOdometry {
   std::vector<std::pair<LidarScan, size_t>> warmup_scans_;
   // After a frozen last pass (calibration.warmup_replay_freeze): what every result reports.
   std::optional<ScanResult::CalibrationEstimate> frozen_;
+  // A background replay and the end time of the scan that adopts it.
+  std::unique_ptr<internal::BackgroundReplay> background_;
+  int64_t adopt_ns_ = 0;
+  size_t background_scans_ = 0;  // the kept span's and the catch-up's scans
+  std::string replay_note_;
+  std::optional<ReplayCost> last_replay_;
 };
 
 // The config of a replay pass started from `estimate` (the calibration after the live warm-up or

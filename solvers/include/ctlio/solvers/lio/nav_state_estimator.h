@@ -11,6 +11,14 @@
 // states are linked only by a weak velocity random walk (imu.gap_velocity_walk) and the bias
 // random walk: the lidar alone registers the scan. The first interval with the IMU back is
 // preintegrated from the estimated state again (the preintegration is re-anchored).
+//
+// Online calibration (calibration_options.h), with the same states as Singer-LIO's
+// (calibration_blocks.h), so CalibrationStates holds, assesses and reports them alike: the
+// extrinsic T_rl, through which every keypoint enters from the lidar frame, and the IMU's clock
+// offset δ (one IMU). A state at the scan end t (lidar clock) sits at IMU time t − δ̄, δ̄ the
+// offset when it was added (estimated or configured): its preintegration and deskew take the IMU
+// samples stamped up to there; the lidar residual carries it ε = δ̄ − δ along the body twist to
+// the scan end (point_to_plane_world_calibrated.h).
 #pragma once
 
 #include <deque>
@@ -60,6 +68,7 @@ class NavStateEstimator final : public Estimator {
     double* velocity = nullptr;  // world frame, 3
     double* bias = nullptr;      // [b_a; b_g]
     bool after_gap = false;      // the interval from the previous state is not preintegrated
+    double offset = 0.0;         // δ̄: the state is at IMU-clock time t − offset
   };
   // Poses T_wb at the boundaries of the IMU segments over [from.t, t_end], integrated from the
   // current estimate of `from` (pose, velocity, bias); between them a constant twist.
@@ -68,10 +77,20 @@ class NavStateEstimator final : public Estimator {
     std::vector<SE3> T_wb;
     SE3 T_end_inv;  // T_wb.back()⁻¹
     SE3 Interpolate(double tau) const;
+    // The body twist [v; ω] over the last step (body frame at its start; zero for one pose).
+    Vec6 EndTwist() const;
     // q (robot frame at τ) moved into the body frame at the table's end.
     Vec3 ToEnd(double tau, const Vec3& q) const { return T_end_inv * (Interpolate(tau) * q); }
   };
-  DeskewTable Integrate(const State& from, double t_end) const;
+  // The table's times are on the lidar clock: IMU time + `to_offset` (δ̄ of the state at t_end).
+  DeskewTable Integrate(const State& from, double t_end, double to_offset) const;
+  // Online calibration: the estimate (else the configured value) of T_rl and δ, and which are
+  // states.
+  bool estimates_extrinsic() const { return config_.calibration.estimate_extrinsic; }
+  bool estimates_time_offset() const { return config_.calibration.estimate_time_offset; }
+  SE3 Extrinsic() const;
+  double TimeOffset() const;
+  const OdometryConfig& config() const { return config_; }
   // The deskew table of the interval ending at `to` (IMU-integrated, or the constant twist
   // between the two states across a gap).
   DeskewTable Deskew(const State& from, const State& to) const;
@@ -80,6 +99,7 @@ class NavStateEstimator final : public Estimator {
   // The signal of the input IMU (config.input_imu) over [t_a, t_b] at the midpoints of the
   // zero-order-hold segments (imu_midpoint.h), rotated into the robot frame. Its lever arm is not
   // modelled: ω̇×p would need the derivative of the gyro.
+  // t_a, t_b: IMU-clock times (segments on the IMU clock).
   std::vector<ImuSegment> InputSegments(double t_a, double t_b, double* max_gap) const;
   State AddNavState(double t, const SE3& T_wb, const Vec3& v, const Vec6& bias,
                     SlidingWindow* window);
@@ -92,7 +112,8 @@ class NavStateEstimator final : public Estimator {
   OdometryConfig config_;
   const ImuBuffer& imu_;
   Vec3 gravity_map_ = Vec3::Zero();
-  std::deque<State> states_;  // oldest first
+  const SlidingWindow* window_ = nullptr;  // set by Initialise (the calibration states)
+  std::deque<State> states_;               // oldest first
   int64_t next_state_ = 0;
   // The motion propagated from the final value of the state sealed last to the next state's time.
   std::optional<DeskewTable> sealed_;
