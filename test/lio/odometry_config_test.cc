@@ -28,6 +28,14 @@ TEST(OdometryConfig, DefaultAccelerometerModelIsTheExactOne) {
                    .exact_specific_force);
 }
 
+TEST(OdometryConfig, DefaultBaselineIntegrationIsTheMidpointOne) {
+  // The paper's zero-order hold (false) is chosen explicitly, as the accelerometer model above.
+  EXPECT_TRUE(OdometryConfig().input_midpoint);
+  EXPECT_TRUE(LoadOdometryConfig(WriteTemp("empty_imu2.yaml", "imu: {}\n")).input_midpoint);
+  EXPECT_FALSE(
+      LoadOdometryConfig(WriteTemp("zoh.yaml", "imu:\n  input_midpoint: false\n")).input_midpoint);
+}
+
 TEST(OdometryConfig, ShippedConfigsLoad) {
   const OdometryConfig sim =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");

@@ -180,7 +180,9 @@ NavStateEstimator::State NavStateEstimator::AddNavState(double t, const SE3& T_w
 std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
                                                          double* max_gap) const {
   std::vector<ImuSegment> segments = imu_.Segments(t_a, t_b, max_gap, config_.input_imu);
-  InterpolateAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
+  if (config_.input_midpoint) {
+    InterpolateAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
+  }
   const Mat3 C_ri = config_.ImuPose(config_.input_imu).rotation();
   if (!C_ri.isIdentity(0.0)) {
     for (ImuSegment& seg : segments) {

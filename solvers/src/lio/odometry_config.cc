@@ -225,6 +225,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"exact_specific_force", SetFromYaml(&c->exact_specific_force)},
                    {"input_accel_sigma", SetFromYaml(&c->input_accel_sigma)},
                    {"input_gyro_sigma", SetFromYaml(&c->input_gyro_sigma)},
+                   {"input_midpoint", SetFromYaml(&c->input_midpoint)},
                    {"rate_hint", SetFromYaml(&c->imu_rate_hint)},
                    {"gap_velocity_walk", SetFromYaml(&c->gap_velocity_walk)},
                    {"gap_hold_max", SetFromYaml(&c->gap_hold_max)},
