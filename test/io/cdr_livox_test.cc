@@ -39,7 +39,7 @@ TEST(CdrLivox, DecodesAHandBuiltCustomMsgFieldByField) {
   EXPECT_EQ(m.timebase, (uint64_t(1) << 40) + 5);
   EXPECT_EQ(m.point_num, 1u);
   EXPECT_EQ(m.lidar_id, 9);
-  EXPECT_EQ(m.rsvd, (std::array<uint8_t, 3>{1, 2, 3}));
+  EXPECT_EQ(m.rsvd, (boost::array<uint8_t, 3>{{1, 2, 3}}));
   ASSERT_EQ(m.points.size(), 1u);
   EXPECT_EQ(m.points[0].offset_time, 1000u);
   EXPECT_EQ(m.points[0].x, 1.0f);
