@@ -70,6 +70,7 @@
 #include "lio/run_evaluation.h"
 #include "lio/run_odometry.h"
 #include "lio/run_outputs.h"
+#include "lio/run_plots.h"
 
 DEFINE_string(dataset, "", "Dataset folder, ROS 1 bag or ROS 2 bag (folder, .mcap, .db3)");
 DEFINE_string(
@@ -86,7 +87,8 @@ DEFINE_string(time_reference, "", "Override: relative (to the message stamp) | a
 DEFINE_string(stamp_at, "", "Override: the message stamp is the scan start | end");
 DEFINE_double(
     imu_accel_scale, 1.0,
-    "rosbag: factor from the accelerometer's unit to m/s² (9.80665 for IMUs reporting g)");
+    "ROS bags: factor from the accelerometer's unit to m/s² (9.80665 for IMUs reporting g); "
+    "given explicitly it wins over input.accel_scale of --config");
 DEFINE_bool(plot, true, "Write the plots (PNG with python3-matplotlib, else an SVG top view)");
 DEFINE_string(python, "", "Python with matplotlib (default: python3, then /usr/bin/python3)");
 DEFINE_double(trajectory_rate, 0.0,
@@ -198,8 +200,9 @@ std::optional<T> Given(const char* flag, const T& value) {
   return apps::Given(!FLAGS_sim_preset.empty() || !FLAGS_sim_sensor.empty(), flag, value);
 }
 
-std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
-  const int64_t gap_ns = std::llround(max_imu_gap_error_s * 1e9);
+// `input`: the config's reader options (input.max_imu_gap_error, input.accel_scale).
+std::unique_ptr<io::DataSource> OpenSource(const lio::InputCheckOptions& input) {
+  const int64_t gap_ns = std::llround(input.max_imu_gap_error * 1e9);
   if (FLAGS_format == "sim") {
     const sim::Preset preset = sim::ParsePreset(FLAGS_sim_preset);
     sim::SimOverrides given;
@@ -237,7 +240,10 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
     o.lidar_topic = FLAGS_lidar_topic;
     o.imu_topic = FLAGS_imu_topic;
     o.preset = FLAGS_preset;
-    o.accel_scale = FLAGS_imu_accel_scale;
+    // --imu_accel_scale given explicitly wins over input.accel_scale of the config.
+    o.accel_scale = gflags::GetCommandLineFlagInfoOrDie("imu_accel_scale").is_default
+                        ? input.accel_scale
+                        : FLAGS_imu_accel_scale;
     o.max_imu_gap_ns = gap_ns;
     o.time.field = FLAGS_time_field;
     if (!FLAGS_time_unit.empty()) o.time.unit = io::ParseTimeUnit(FLAGS_time_unit);
@@ -266,37 +272,6 @@ std::unique_ptr<io::DataSource> OpenSource(double max_imu_gap_error_s) {
 #ifndef CTLIO_TOOLS_DIR
 #define CTLIO_TOOLS_DIR "tools"
 #endif
-
-// --python, else the first of python3, /usr/bin/python3 with matplotlib; empty if none.
-std::string PythonWithMatplotlib() {
-  // Probed once per process: each probe starts a python (the plots and every method's map ask).
-  static const std::string found = [] {
-    std::string python = FLAGS_python;
-    for (const char* p : {"python3", "/usr/bin/python3"}) {
-      if (!python.empty()) break;
-      const std::string probe = std::string(p) + " -c 'import matplotlib' >/dev/null 2>&1";
-      if (std::system(probe.c_str()) == 0) python = p;
-    }
-    return python;
-  }();
-  return found;
-}
-
-// Runs tools/plot_odometry.py on the method folders; false if no python3 with matplotlib ran it.
-bool PlotWithMatplotlib(const std::string& out, const std::vector<std::string>& folders) {
-  const std::string python = PythonWithMatplotlib();
-  if (python.empty()) return false;
-  std::string cmd = python + " '" + CTLIO_TOOLS_DIR + "/plot_odometry.py' '" + out + "'";
-  for (const std::string& f : folders) cmd += " '" + f + "'";
-  bool ok = std::system((cmd + " >/dev/null").c_str()) == 0;
-  // The online calibration's estimates and ±3σ over time (calibration.png per method folder).
-  for (const std::string& f : folders) {
-    if (!std::filesystem::exists(f + "/calibration.csv")) continue;
-    const std::string c = python + " '" + CTLIO_TOOLS_DIR + "/plot_calibration.py' '" + f + "'";
-    ok = std::system((c + " >/dev/null").c_str()) == 0 && ok;
-  }
-  return ok;
-}
 
 }  // namespace
 
@@ -381,7 +356,7 @@ int main(int argc, char** argv) {
       ctlio::io::WarningLimiter::SetStrict(gflags::GetCommandLineFlagInfoOrDie("strict").is_default
                                                ? config.input.strict
                                                : FLAGS_strict);
-      auto source = OpenSource(config.input.max_imu_gap_error);
+      auto source = OpenSource(config.input);
       if (FLAGS_config.empty() && m == methods.front()) io::LogSensorSuggestion(*source);
       const std::string out = methods.size() > 1 ? FLAGS_out + "/" + m : FLAGS_out;
       std::filesystem::create_directories(out);
@@ -472,8 +447,8 @@ int main(int argc, char** argv) {
       if (map) {
         const std::string map_path = lioapp::MapPath(FLAGS_save_map, out, m, methods.size() > 1);
         lioapp::WriteMap(*map, map_path, out + "/trajectory.tum", FLAGS_plot,
-                         FLAGS_plot ? PythonWithMatplotlib() : "", CTLIO_TOOLS_DIR,
-                         m + " on " + run.source, ev);
+                         FLAGS_plot ? lioapp::PythonWithMatplotlib(FLAGS_python) : "",
+                         CTLIO_TOOLS_DIR, m + " on " + run.source, ev);
         files.Add(map_path, "the registered, deskewed map (--save_map), map frame, x y z float32");
         const std::string map_png = lioapp::MapPicturePath(map_path);
         std::error_code no_png;
@@ -487,7 +462,8 @@ int main(int argc, char** argv) {
       files.Add(ev_path, "counts, times [ms], ATE [m] of the run (one `key value` per line)");
       runs.push_back(std::move(run));
     }
-    if (FLAGS_plot && !PlotWithMatplotlib(FLAGS_out, folders)) {
+    const std::string python = FLAGS_plot ? lioapp::PythonWithMatplotlib(FLAGS_python) : "";
+    if (FLAGS_plot && !lioapp::PlotRuns(python, CTLIO_TOOLS_DIR, FLAGS_out, folders)) {
       std::fprintf(stderr, "plots: no python3 with matplotlib, SVG top view instead\n");
       for (size_t k = 0; k < runs.size(); ++k) {
         if (!runs[k].ate) continue;
@@ -498,24 +474,7 @@ int main(int argc, char** argv) {
                                 truths[k], runs[k].ate->alignment, title);
       }
     }
-    // The plots this run made (not those an earlier run left in the folder).
-    const auto made = [&](const std::string& path) {
-      std::error_code error;
-      return std::filesystem::exists(path, error) &&
-             std::filesystem::last_write_time(path, error) >= run_start;
-    };
-    for (const std::string& f : folders) {
-      for (const auto& [name, what] :
-           {std::pair<const char*, const char*>{"odometry.png",
-                                                "plot: trajectory, errors, scan times"},
-            {"calibration.png", "plot: calibration estimates, ±3σ"},
-            {"trajectory_topview.svg", "plot: top view (no matplotlib)"}}) {
-        if (made(f + "/" + name)) files.Add(f + "/" + name, what);
-      }
-    }
-    if (folders.size() > 1 && made(FLAGS_out + "/comparison.png")) {
-      files.Add(FLAGS_out + "/comparison.png", "plot: the methods side by side");
-    }
+    lioapp::ListPlots(FLAGS_out, folders, run_start, &files);
     lioapp::PrintRunTables(runs);
     std::printf("\n");
     std::ostringstream listing;

@@ -1,7 +1,8 @@
 // The shipped per-sensor configs (data/sensors/<sensor>.yaml): one per simulator sensor model,
 // each loads through its base, carries its sensor's IMU rate and a noise no lower than its own,
-// and an extrinsic exactly where the device fixes one (Ouster, Livox): never for an external IMU
-// (Velodyne, Hesai), whose recording's /tf_static a config extrinsic would silently override.
+// the driver's accelerometer unit, and an extrinsic exactly where the device fixes one (Ouster,
+// Livox): never for an external IMU (Velodyne, Hesai), whose recording's /tf_static a config
+// extrinsic would silently override.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -28,6 +29,9 @@ TEST(SensorConfigs, OnePerModelWithItsImuAndExtrinsic) {
     EXPECT_GE(c.input_accel_sigma, m.accel_noise);
     EXPECT_GE(c.input_gyro_sigma, m.gyro_noise);
     EXPECT_LE(c.frontend.max_range, m.lidar.max_range);
+    // The bag readers' accelerometer unit is the driver's (Livox: g), so that the file alone
+    // reads the device's bags (input.accel_scale; no --imu_accel_scale).
+    EXPECT_EQ(c.input.accel_scale, m.driver.accel_unit);
     const bool built_in_imu =
         m.driver.format != io::PointFormat::kVelodyne && m.driver.format != io::PointFormat::kHesai;
     EXPECT_EQ(LoadOdometryYaml(path)["extrinsic"].IsDefined(), built_in_imu);

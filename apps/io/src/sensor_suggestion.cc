@@ -48,7 +48,7 @@ std::optional<SensorSuggestion> SuggestSensorConfig(const RecordingTraits& t) {
   const std::string& d = t.time_driver;
   if (Contains(t.lidar_type, "livox") || Contains(d, "Livox") || Contains(t.lidar_topic, "livox")) {
     s.sensor = t.azimuth_span_deg < 180.0 ? "avia" : "mid360";
-    s.note = "Livox IMUs publish g: add --imu_accel_scale=9.80665";
+    s.note = "Livox IMUs publish g: the config sets input.accel_scale: 9.80665";
   } else if (d == "Velodyne" || Contains(t.lidar_topic, "velodyne")) {
     s.sensor = t.rings > 0 && t.rings <= 16 ? "vlp16" : "hdl32e";
   } else if (d == "Hesai/Robosense" || Contains(t.lidar_topic, "hesai") ||

@@ -23,6 +23,8 @@ void InputCheckOptions::Validate() const {
           "scan_time_tolerance must be in [0, 1000) s");
   require(max_imu_gap_error >= 0 && max_imu_gap_error < 1e6,
           "max_imu_gap_error must be in [0, 1e6) s (0 = off)");
+  require(accel_scale > 0 && std::isfinite(accel_scale),
+          "accel_scale must be positive and finite (9.80665 for an IMU reporting g)");
 }
 
 std::optional<std::string> CheckImuRange(const ImuSample& s, const InputCheckOptions& o) {

@@ -310,6 +310,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"moving_rotation", SetFromYaml(&o.moving_rotation)},
                    {"scan_time_tolerance", SetFromYaml(&o.scan_time_tolerance)},
                    {"max_imu_gap_error", SetFromYaml(&o.max_imu_gap_error)},
+                   {"accel_scale", SetFromYaml(&o.accel_scale)},
                    {"strict", SetFromYaml(&o.strict)}});
     } else {
       throw std::runtime_error(YamlWhere(source, kv.first.Mark()) + ": unknown key '" + section +

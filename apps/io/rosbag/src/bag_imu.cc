@@ -50,7 +50,8 @@ void BagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
     if (imu_messages == 200 && accel_norm_sum / 200 > 0.5 && accel_norm_sum / 200 < 1.5) {
       LOG(WARNING) << path << ": " << imu_topic << ": mean |accelerometer| over the first 200 "
                    << "samples is " << accel_norm_sum / 200 << ": the IMU seems to report g, not "
-                   << "m/s²; scale it with --imu_accel_scale=9.80665";
+                   << "m/s²; scale it with input.accel_scale: 9.80665 in the config or "
+                   << "--imu_accel_scale=9.80665";
     }
   }
   imu.push_back(s);

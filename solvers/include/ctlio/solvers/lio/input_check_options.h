@@ -18,6 +18,11 @@ struct InputCheckOptions {
   // gaps are warnings and the odometry bridges them (it flags the scans by
   // OdometryConfig::max_imu_gap).
   double max_imu_gap_error = 0.0;  // s
+  // ROS bag readers (not the odometry): the accelerometer's readings are multiplied by this to
+  // give m/s² (sensor_msgs/Imu's unit); 9.80665 for drivers that publish g (Livox's built-in IMU),
+  // so that a sensor's config is self-contained. ctlio_odometry --imu_accel_scale, given
+  // explicitly, wins; dataset folders and the simulator are in m/s² and ignore it.
+  double accel_scale = 1.0;
   // Strict input (docs/user-guide/bad-input.md): every recovery of the readers and of these gates
   // is an error naming the defect, for pipelines that must not guess. ctlio_odometry --strict
   // (given explicitly) wins over it; programs apply it with io::WarningLimiter::SetStrict.
