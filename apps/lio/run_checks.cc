@@ -115,7 +115,8 @@ ImuConsistency CheckImuConsistency(const std::vector<lio::ScanResult>& scans,
     found = std::string("median chi2/dof ") + Number("%.3g", c.median_accel) + " of " +
             "the accelerometer terms over " + std::to_string(accel.size()) +
             " moving scans (threshold " + Number("%g", options.max_accel) +
-            "): the accelerometer's sign (scale -1 reads like an upside-down IMU at rest and "
+            "; clean simulated runs 0.003 to 18): the accelerometer's sign (scale -1 reads like an "
+            "upside-down IMU at rest and "
             "passes the gravity check), axes or units (g, not m/s^2) are likely wrong, or its "
             "noise setting " +
             "imu.accel_variance = " + Number("%g (m/s^2)^2", config.accel_variance) +
@@ -126,15 +127,13 @@ ImuConsistency CheckImuConsistency(const std::vector<lio::ScanResult>& scans,
              Number("%.3g", c.median_gyro) + " of the gyro terms over " +
              std::to_string(gyro.size()) + " moving scans (threshold " +
              Number("%g", options.max_gyro) +
-             "): the gyro's sign, axes or units (deg/s, not rad/s) are likely wrong, or "
+             "; clean simulated runs 0.003 to 0.14): the gyro's sign, axes or units (deg/s, not "
+             "rad/s) are likely wrong, or "
              "imu.gyro_variance = " +
              Number("%g (rad/s)^2", config.gyro_variance) + " is too small";
   }
   if (!found.empty()) {
-    c.warning =
-        "the IMU disagrees with the motion the lidar fixed (about 1 or below when they "
-        "agree): " +
-        found;
+    c.warning = "the IMU disagrees with the motion the lidar fixed: " + found;
   }
   return c;
 }

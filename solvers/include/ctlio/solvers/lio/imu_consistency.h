@@ -6,8 +6,10 @@
 // estimate cannot agree with — its sign flipped (f' = −f reads like an upside-down IMU at rest,
 // so the gravity check passes, but gives −2·C_bm·a_m against the lidar's motion while the
 // platform accelerates), axes swapped, the wrong units — or a noise setting far too small leaves
-// χ²/dof ≫ 1 once the lidar has fixed the motion. The robust loss is not applied: the Cauchy loss
-// of the accelerometer would cap exactly the residuals that tell.
+// χ²/dof ≫ 1 where the lidar wins over the accelerometer. Where the estimate follows the
+// accelerometer instead (the attitude tilts so that gravity explains it), the IMU terms stay
+// satisfied and the lidar's cost grows: not seen here (measured: bad-input.md). The robust loss
+// is not applied: the Cauchy loss of the accelerometer would cap the residuals that tell.
 #pragma once
 
 #include <ceres/problem.h>
