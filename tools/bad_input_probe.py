@@ -38,7 +38,7 @@ WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
                  "points_dropped_out_of_interval", "scans_skipped", "constant_imu_scans",
                  "lidar_gaps", "overlapping_scans")
 WARN_KEYS = ("first_input_warning", "extrinsic_disagreement", "no_ate", "first_lidar_gap",
-             "input_defect", "config_warning")
+             "input_defect", "config_warning", "imu_inconsistency")
 
 
 # ---------------------------------------------------------------- folder helpers
@@ -310,7 +310,7 @@ def judge(rc, log, peak_mb, out_dir, names, clean_ate):
     warned = any(float(ev.get(k, "0") or 0) > 0 for k in WARN_COUNTERS) or any(
         k in ev for k in WARN_KEYS)
     if warned:
-        return "warned", ev.get("first_input_warning", msg)[:200]
+        return "warned", next((ev[k] for k in WARN_KEYS if k in ev), msg)[:200]
     if ate is not None and float(ate) > 3 * clean_ate:
         return "silent_wrong", f"ATE {float(ate):.4f} m vs clean {clean_ate:.4f} m"
     return "accurate", ""

@@ -67,6 +67,11 @@ void WriteRunEvaluation(const RunSummary& run,
      << run.scans_skipped << "\nconstant_imu_scans " << run.constant_imu_scans << "\nlidar_gaps "
      << run.lidar_gaps << "\n";
   if (run.lidar_gaps > 0) ev << "first_lidar_gap \"" << run.first_lidar_gap << "\"\n";
+  ev << "imu_consistency_scans " << run.imu_consistency_scans << "\nmedian_accel_chi2_per_dof "
+     << run.median_accel_chi2 << "\nmedian_gyro_chi2_per_dof " << run.median_gyro_chi2 << "\n";
+  if (!run.imu_inconsistency.empty()) {
+    ev << "imu_inconsistency \"" << run.imu_inconsistency << "\"\n";
+  }
   if (run.overlapping_scans > 0) {
     ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
        << run.first_overlapping_scan << "\"\n";
@@ -228,6 +233,9 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     if (r.overlapping_scans > 0) {
       std::printf("  %-10s WARNING %d scan(s) begin before the previous scan's end (first: %s)\n",
                   r.method.c_str(), r.overlapping_scans, r.first_overlapping_scan.c_str());
+    }
+    if (!r.imu_inconsistency.empty()) {
+      std::printf("  %-10s WARNING imu: %s\n", r.method.c_str(), r.imu_inconsistency.c_str());
     }
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),

@@ -429,6 +429,14 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                  << "spacing over 3x the median scan period), longest " << gaps.longest_s
                  << " s; first: " << gaps.first;
   }
+  const ImuConsistency imu = CheckImuConsistency(run.scans, config);
+  run.imu_consistency_scans = imu.moving_scans;
+  run.median_accel_chi2 = imu.median_accel;
+  run.median_gyro_chi2 = imu.median_gyro;
+  run.imu_inconsistency = imu.warning;
+  if (!imu.warning.empty()) {
+    LOG(WARNING) << source.Name() << ": " << run.method << ": " << imu.warning;
+  }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2 ||
                 !run.unregistered_run.empty();

@@ -145,6 +145,11 @@ struct RunSummary {
   std::string unregistered_run;
   int lidar_gaps = 0;
   std::string first_lidar_gap;
+  // IMU–lidar consistency (CheckImuConsistency): the medians over the moving scans, and the
+  // warning when they exceed the thresholds (empty otherwise); not a failure.
+  int imu_consistency_scans = 0;
+  double median_accel_chi2 = 0.0, median_gyro_chi2 = 0.0;
+  std::string imu_inconsistency;
   // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`
   // (the estimate left the room of any sensible error), or the lidar registered no scan.
   bool failure = false;

@@ -100,7 +100,7 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
        "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z imu_rejected "
        "points_dropped degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info "
-       "degen_prior_info message\n";
+       "degen_prior_info accel_chi2 accel_dof gyro_chi2 gyro_dof message\n";
   f << std::setprecision(12);
   for (size_t i = 0; i < run.scans.size(); ++i) {
     const lio::ScanResult& r = run.scans[i];
@@ -123,7 +123,8 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
     } else {
       f << "- - - - - - ";
     }
-    f << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+    f << r.accel_chi2 << ' ' << r.accel_dof << ' ' << r.gyro_chi2 << ' ' << r.gyro_dof << ' '
+      << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
   io::CloseChecked(f, path);
 }

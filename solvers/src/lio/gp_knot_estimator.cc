@@ -220,6 +220,7 @@ void GpKnotEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
 void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                ScanResult* result) {
   // K knots over the sweep: at t_prev + (i/K)·Δt, the last exactly at the scan end.
+  imu_blocks_.clear();
   const int K = config_.knots_per_scan;
   const double t_prev = knots_.back().t;
   for (int i = 1; i <= K; ++i) {
@@ -301,7 +302,7 @@ gp::KnotState GpKnotEstimator::InitialGuess(const Knot& prev, double t,
 
 void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int imu_index,
                                          const std::vector<ImuSample>& imu, SlidingWindow* window,
-                                         ScanResult* result) const {
+                                         ScanResult* result) {
   const Mat3 gyro_cov = config_.GyroVariance(imu_index) * Mat3::Identity();
   const Mat3 accel_cov = config_.AccelVariance(imu_index) * Mat3::Identity();
   const imu::ImuMounting& mounting = mountings_[imu_index];
@@ -326,15 +327,17 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
         std::vector<StateId> g = gyro_states, a = accel_states;
         g.push_back(TimeOffsetKey(imu_index));
         a.push_back(TimeOffsetKey(imu_index));
-        window->AddResidualBlock(new imu::ImuGyroMeasurementWithTimeOffset(
-                                     model_, prev.t, k.t, stamp, s.gyro, gyro_cov, mounting),
-                                 nullptr, g);
+        imu_blocks_.gyro.push_back(
+            window->AddResidualBlock(new imu::ImuGyroMeasurementWithTimeOffset(
+                                         model_, prev.t, k.t, stamp, s.gyro, gyro_cov, mounting),
+                                     nullptr, g));
         ++result->imu_residuals;
         if (config_.method == LioMethod::kSingerLio) {
-          window->AddResidualBlock(new imu::ImuAccelMeasurementWithTimeOffset(
-                                       model_, prev.t, k.t, stamp, s.accel, accel_cov,
-                                       config_.gravity, accel_model, mounting),
-                                   accel_loss.get(), a);
+          imu_blocks_.accel.push_back(window->AddResidualBlock(
+              new imu::ImuAccelMeasurementWithTimeOffset(model_, prev.t, k.t, stamp, s.accel,
+                                                         accel_cov, config_.gravity, accel_model,
+                                                         mounting),
+              accel_loss.get(), a));
           accel_loss_used = accel_loss != nullptr;
           ++result->imu_residuals;
         }
@@ -342,15 +345,15 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
       }
       // A configured offset, held: the fixed-time factors at t + δ (on the interval).
       const double tau = std::clamp(stamp + delta, prev.t, k.t);
-      window->AddResidualBlock(
+      imu_blocks_.gyro.push_back(window->AddResidualBlock(
           new imu::ImuGyroMeasurement(model_, prev.t, k.t, tau, s.gyro, gyro_cov, mounting),
-          nullptr, gyro_states);
+          nullptr, gyro_states));
       ++result->imu_residuals;
       if (config_.method == LioMethod::kSingerLio) {
-        window->AddResidualBlock(
+        imu_blocks_.accel.push_back(window->AddResidualBlock(
             new imu::ImuAccelMeasurement(model_, prev.t, k.t, tau, s.accel, accel_cov,
                                          config_.gravity, accel_model, mounting),
-            accel_loss.get(), accel_states);
+            accel_loss.get(), accel_states));
         accel_loss_used = accel_loss != nullptr;
         ++result->imu_residuals;
       }
@@ -365,13 +368,14 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
     const auto state =
         std::make_shared<gp::SharedStateInterpolation>(model_, prev.t, k.t, tau, knots);
     window->shared_interpolations().Add(state);
-    window->AddResidualBlock(new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov, mounting),
-                             nullptr, gyro_states);
+    imu_blocks_.gyro.push_back(window->AddResidualBlock(
+        new imu::ImuGyroMeasurement(state, s.gyro, gyro_cov, mounting), nullptr, gyro_states));
     ++result->imu_residuals;
     if (config_.method == LioMethod::kSingerLio) {
-      window->AddResidualBlock(new imu::ImuAccelMeasurement(state, s.accel, accel_cov,
-                                                            config_.gravity, accel_model, mounting),
-                               accel_loss.get(), accel_states);
+      imu_blocks_.accel.push_back(window->AddResidualBlock(
+          new imu::ImuAccelMeasurement(state, s.accel, accel_cov, config_.gravity, accel_model,
+                                       mounting),
+          accel_loss.get(), accel_states));
       accel_loss_used = accel_loss != nullptr;
       ++result->imu_residuals;
     }

@@ -11,6 +11,7 @@
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/gravity_alignment.h"
+#include "ctlio/solvers/lio/imu_consistency.h"
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/pose_covariance.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
@@ -224,6 +225,13 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->final_cost = registered.final_cost;
   result->ms_associate = registered.ms_associate;
   result->ms_solve = registered.ms_solve;
+  // The IMU terms' own χ² at the final estimate, for the run's consistency check (run_checks.h).
+  ChiSquare accel, gyro;
+  EvaluateImuChiSquare(&window_.problem(), estimator_->NewestImuBlocks(), &accel, &gyro);
+  result->accel_chi2 = accel.chi2;
+  result->accel_dof = accel.dof;
+  result->gyro_chi2 = gyro.chi2;
+  result->gyro_dof = gyro.dof;
 
   const auto t_map = std::chrono::steady_clock::now();
   if (EstimatePlausible(result)) {

@@ -362,6 +362,7 @@ void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
 
 void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                  ScanResult* result) {
+  imu_blocks_.clear();
   const State prev = states_.back();
   double max_gap = 0.0;
   // On the IMU clock: from the previous state to this scan's end at the current offset estimate.
@@ -384,9 +385,9 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
   states_.push_back(AddNavState(scan.t_end, SE3(pred.C, pred.p), pred.v, bias_hat, window));
   states_.back().offset = offset;
   const State& s = states_.back();
-  window->AddResidualBlock(
+  imu_blocks_.accel.push_back(window->AddResidualBlock(
       new imu::PreintegratedImuFactor(pim, gravity_map_), nullptr,
-      {prev.keys.pose, prev.keys.velocity, prev.keys.bias, s.keys.pose, s.keys.velocity});
+      {prev.keys.pose, prev.keys.velocity, prev.keys.bias, s.keys.pose, s.keys.velocity}));
   window->AddResidualBlock(MakeBiasRandomWalk(config_, s.t - prev.t), nullptr,
                            {prev.keys.bias, s.keys.bias});
   result->imu_residuals = 1;

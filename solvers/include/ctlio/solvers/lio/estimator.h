@@ -14,6 +14,7 @@
 
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/imu_buffer.h"
+#include "ctlio/solvers/lio/imu_consistency.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/scan_registration.h"
 #include "ctlio/solvers/sliding_window.h"
@@ -87,6 +88,13 @@ class Estimator {
 
   // How an IMU gap is bridged (for the scan's status message).
   virtual std::string ImuGapRecovery() const = 0;
+
+  // The IMU residual blocks the last AddState added (imu_consistency.h), for their χ² after the
+  // solve; empty for a pipeline without IMU terms.
+  virtual const ImuTermBlocks& NewestImuBlocks() const { return no_imu_blocks_; }
+
+ private:
+  ImuTermBlocks no_imu_blocks_;
 };
 
 // The estimator of config.method. `imu` is the odometry's buffer (read only).

@@ -61,6 +61,7 @@ class GpKnotEstimator final : public Estimator {
   std::vector<SE3> SealOldest(const std::vector<double>& t) override;
   std::vector<SE3> UnsealedPoses(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override { return "the GP prior bridges it"; }
+  const ImuTermBlocks& NewestImuBlocks() const override { return imu_blocks_; }
 
  private:
   // A knot's blocks live in the window (which owns the storage).
@@ -110,7 +111,7 @@ class GpKnotEstimator final : public Estimator {
   // Gyro and accelerometer samples of IMU `imu` in (prev.t, k.t] as measurements (SPEC §3).
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,
-                          ScanResult* result) const;
+                          ScanResult* result);
   // Clock offsets in use (estimated or configured non-zero), and IMU j's current δ_j.
   bool time_offsets() const { return uses_imu() && time_offsets_; }
   double TimeOffset(int imu, const SlidingWindow& window) const;
@@ -127,6 +128,7 @@ class GpKnotEstimator final : public Estimator {
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
   std::optional<TimedState> sealed_;       // the final value of the knot sealed last
+  ImuTermBlocks imu_blocks_;               // those the last AddState added
 };
 
 }  // namespace ctlio::lio

@@ -59,6 +59,7 @@ class NavStateEstimator final : public Estimator {
   std::vector<SE3> SealOldest(const std::vector<double>& t) override;
   std::vector<SE3> UnsealedPoses(const std::vector<double>& t) const override;
   std::string ImuGapRecovery() const override;
+  const ImuTermBlocks& NewestImuBlocks() const override { return imu_blocks_; }
 
   // A state's blocks live in the window.
   struct State {
@@ -117,6 +118,7 @@ class NavStateEstimator final : public Estimator {
   int64_t next_state_ = 0;
   // The motion propagated from the final value of the state sealed last to the next state's time.
   std::optional<DeskewTable> sealed_;
+  ImuTermBlocks imu_blocks_;  // the preintegrated factor the last AddState added
 };
 
 }  // namespace ctlio::lio

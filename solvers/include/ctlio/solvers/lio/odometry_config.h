@@ -240,6 +240,14 @@ struct ScanResult {
   int rounds = 0;  // re-association rounds
   int solver_iterations = 0;
   double final_cost = 0.0;
+  // Whitened χ² (no robust loss) of the IMU terms this scan added, at its final estimate, and
+  // their residual components (imu_consistency.h): χ²/dof ≈ 1 when the IMU agrees with the lidar
+  // and its noise setting is right. Singer-LIO: accelerometer and gyro; lidar_gyro: gyro; the
+  // baseline: its preintegrated factor (9 components) as accel. 0 without IMU terms.
+  double accel_chi2 = 0.0;
+  int accel_dof = 0;
+  double gyro_chi2 = 0.0;
+  int gyro_dof = 0;
   double milliseconds = 0.0;    // wall time of this scan, split into:
   double ms_preprocess = 0.0;   // range gate, subsampling, keypoints
   double ms_associate = 0.0;    // interpolation + kNN + plane fits, all rounds
