@@ -161,9 +161,9 @@ DEFINE_string(time_offset, "",
               "Comma-separated clock offset per IMU [s] (calibration.time_offset_s): the prior "
               "mean when estimated, else applied as given");
 DEFINE_bool(calibration_keep_unobservable, true,
-            "calibration.yaml keeps the start value of every calibration coordinate whose sigma "
-            "is not below its threshold (calibration.write_max_sigma_s/_deg/_m: the data did not "
-            "inform it); false writes the last estimates as they are");
+            "calibration.yaml keeps the start value of every calibration coordinate the data "
+            "did not inform (calibration.write_max_sigma_*, write_max_unobservable_fraction); "
+            "false writes the last estimates as they are");
 DEFINE_string(sim_extrinsic_error, "",
               "--format sim: hand the odometry a NOMINAL extrinsic off the simulated one by "
               "<angle>deg[@ax:ay:az],<distance>m[@dx:dy:dz], e.g. 3deg,0.10m (axis and direction "

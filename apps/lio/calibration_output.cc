@@ -119,7 +119,9 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
   r.extrinsic_from_start = moved;
   const std::vector<double> fraction = UnobservableFraction(run);
   const std::vector<std::string> names = CalibrationCoordinates(c);
-  // Coordinate i: the estimate where its σ is below `threshold`, else the start; false: start.
+  const size_t imus = r.time_offset_s.size();
+  const std::vector<double> prior = options.PriorSigmas(static_cast<int>(imus), c.has_extrinsic);
+  // Coordinate i: the estimate or the start by RecommendCalibration's rule (1–3); false: start.
   const auto choose = [&](size_t i, double estimate, double sigma, double start, double threshold) {
     CoordinateChoice k;
     k.name = names[i];
@@ -127,27 +129,46 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
     k.sigma = sigma;
     k.start = start;
     k.threshold = threshold;
+    k.prior_sigma = i < prior.size() ? prior[i] : NAN;
     if (i < fraction.size()) k.unobservable_fraction = fraction[i];
     // σ = 0 is what a scan without a covariance reports (a failed one): no σ, not a certain one.
     const bool has_sigma = std::isfinite(sigma) && sigma > 0.0;
+    const double ratio = sigma / k.prior_sigma;
+    const bool assessed = k.unobservable_fraction >= 0.0;
+    const bool contradicted =
+        assessed && k.unobservable_fraction > options.write_max_unobservable_fraction;
+    std::ostringstream why;
     if (!keep_uninformed_at_start) {
       k.estimate_written = true;
-      k.reason = "the estimate, as asked (--calibration_keep_unobservable=false)";
+      why << "the estimate, as asked (--calibration_keep_unobservable=false)";
     } else if (!has_sigma) {
-      k.reason = "the start: the run reported no sigma for it (a failed covariance)";
+      why << "the start: the run reported no sigma for it (a failed covariance)";
     } else if (sigma < threshold) {
       k.estimate_written = true;
-      k.reason = "the estimate: sigma below the threshold, " + Threshold(k.name, threshold);
+      why << "the estimate: sigma below the threshold, " << Threshold(k.name, threshold);
+    } else if (ratio <= options.write_max_sigma_ratio && !contradicted) {
+      k.estimate_written = true;
+      why << "the estimate: the data informed it, sigma " << std::setprecision(2) << ratio
+          << " of the prior's (at most " << options.write_max_sigma_ratio
+          << ", calibration.write_max_sigma_ratio)" << (assessed ? "" : "; no observability check");
+    } else if (ratio <= options.write_max_sigma_ratio) {
+      why << "the start: sigma " << std::setprecision(2) << ratio
+          << " of the prior's, but flagged unobservable after more than "
+          << std::lround(100.0 * options.write_max_unobservable_fraction)
+          << "% of the scans (calibration.write_max_unobservable_fraction): a drift the "
+             "window's sigma does not show";
     } else {
-      k.reason = "the start: sigma not below the threshold, " + Threshold(k.name, threshold) +
-                 ": the data did not inform it";
+      why << "the start: sigma " << std::setprecision(2) << ratio
+          << " of the prior's (above calibration.write_max_sigma_ratio "
+          << options.write_max_sigma_ratio << ") and not below the threshold, "
+          << Threshold(k.name, threshold) << ": the data did not inform it";
     }
+    k.reason = why.str();
     k.written = k.estimate_written ? estimate : start;
     if (!k.estimate_written) r.kept_at_start.push_back(k.name);
     r.coordinates.push_back(k);
     return k.estimate_written;
   };
-  const size_t imus = r.time_offset_s.size();
   for (size_t j = 0; j < imus; ++j) {
     const double start = j < run.initial_time_offsets.size() ? run.initial_time_offsets[j] : 0.0;
     const double sigma = j < c.time_offset_sigma_s.size() ? c.time_offset_sigma_s[j] : NAN;
@@ -284,11 +305,12 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
     << "# Use it after the config the run used, --config my.yaml,calibration.yaml (later files\n"
     << "# win key by key), or paste the keys at the end into that config\n"
     << "# (docs/user-guide/calibration.md).\n#\n"
-    << "# Per coordinate, top-down: the run's last estimate, its marginal sigma, the value the "
-       "run\n"
-    << "# started from, the value written below and why. The estimate is written where its sigma\n"
-    << "# is below the threshold of its kind (calibration.write_max_sigma_s, _deg, _m), else the\n"
-    << "# start is kept: the data did not inform it.\n";
+    << "# Per coordinate, top-down: the run's last estimate, its marginal sigma, the prior sigma\n"
+    << "# the estimate started with, the value the run started from, the value written below and\n"
+    << "# why. The estimate is written where its sigma is below the threshold of its kind\n"
+    << "# (calibration.write_max_sigma_s, _deg, _m), or where the data informed it: sigma at most\n"
+    << "# write_max_sigma_ratio of the prior's and flagged unobservable after at most\n"
+    << "# write_max_unobservable_fraction of the scans. Else the start is kept.\n";
   if (c.has_extrinsic) {
     f << "# The extrinsic's coordinates are [rho; phi] of T_imu_lidar = Exp([rho; phi]) * T_start\n"
       << "# (calibration.csv's), so its start is 0.\n";
@@ -310,18 +332,19 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
     const CoordinateChoice& k = recommended.coordinates[i];
     const Unit u = DisplayUnit(k.name);
     f << "#\n# " << k.name << " [" << u.name << "]\n"
-      << "#   estimate   " << u.scale * k.estimate << "\n"
-      << "#   sigma      " << u.scale * k.sigma << "\n"
-      << "#   start      " << u.scale * k.start << "\n"
-      << "#   written    " << u.scale * k.written << "\n"
-      << "#   why        " << k.reason << "\n";
-    if (const auto t = truth(i)) {
-      f << "#   truth      " << u.scale * *t << " (the written value is off by "
-        << u.scale * (k.written - *t) << ")\n";
-    }
+      << "#   estimate     " << u.scale * k.estimate << "\n"
+      << "#   sigma        " << u.scale * k.sigma << "\n"
+      << "#   prior sigma  " << u.scale * k.prior_sigma << "\n"
+      << "#   start        " << u.scale * k.start << "\n";
     if (k.unobservable_fraction >= 0.0) {
-      f << "#   flagged unobservable after " << std::lround(100.0 * k.unobservable_fraction)
-        << "% of the scans (information: the observability check)\n";
+      f << "#   flagged      unobservable after " << std::lround(100.0 * k.unobservable_fraction)
+        << "% of the scans (the observability check)\n";
+    }
+    f << "#   written      " << u.scale * k.written << "\n"
+      << "#   why          " << k.reason << "\n";
+    if (const auto t = truth(i)) {
+      f << "#   truth        " << u.scale * *t << " (the written value is off by "
+        << u.scale * (k.written - *t) << ")\n";
     }
   }
   f << std::setprecision(9);

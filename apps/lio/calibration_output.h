@@ -44,23 +44,29 @@ void WriteCalibrationLog(const std::string& path, const RunSummary& run,
 // value written and why. Units: δ in s; the extrinsic's ρ in m and φ in rad, as the left-tangent
 // components of Log(T·T_start⁻¹) (calibration.csv's coordinates), so its start is 0.
 struct CoordinateChoice {
-  std::string name;        // CalibrationCoordinates
-  double estimate = 0.0;   // the last estimate
-  double sigma = 0.0;      // its marginal σ (NaN: none reported)
-  double start = 0.0;      // the value the run started from
-  double threshold = 0.0;  // calibration.write_max_sigma_* of its kind, same unit
+  std::string name;          // CalibrationCoordinates
+  double estimate = 0.0;     // the last estimate
+  double sigma = 0.0;        // its marginal σ (NaN: none reported)
+  double start = 0.0;        // the value the run started from
+  double threshold = 0.0;    // calibration.write_max_sigma_* of its kind, same unit
+  double prior_sigma = 0.0;  // the prior σ the calibration state started with, same unit
   bool estimate_written = false;
   double written = 0.0;                 // estimate or start
   std::string reason;                   // why that one, for a person
   double unobservable_fraction = -1.0;  // of the assessed scans (< 0: not assessed); information
 };
 
-// The calibration a run recommends using in a config: per coordinate the last estimate where
-// its marginal σ is below the threshold of its kind (options.write_max_sigma_s, _deg, _m), else
-// the value the run started from (δ_j: run.initial_time_offsets; the extrinsic's ρ / φ set to
-// zero), because a σ that large says the data did not inform it. The share of scans on which the
-// observability check flagged a coordinate does not decide (issue 45: an offset estimated
-// 20.045 ± 0.20 ms, flagged on 81% of the scans, is a calibration); it is kept as information.
+// The calibration a run recommends using in a config, per coordinate (CalibrationOptions):
+//  1. the last estimate where its marginal σ is below the threshold of its kind
+//     (options.write_max_sigma_s, _deg, _m), whatever share of scans the observability check
+//     flagged (issue 45: an offset estimated 20.045 ± 0.20 ms, flagged on 81% of the scans, is
+//     a calibration);
+//  2. else the estimate where the data informed it: σ ≤ write_max_sigma_ratio × the prior σ and
+//     the check flagged it after at most write_max_unobservable_fraction of the assessed scans
+//     (not assessed: σ alone);
+//  3. else the value the run started from (δ_j: run.initial_time_offsets; the extrinsic's ρ / φ
+//     set to zero): σ near the prior's, or a small σ the check contradicts (the slow regime's
+//     drift, whose window σ counts the marginal prior again each slide).
 // `keep_uninformed_at_start` false writes every estimate. Nothing without an estimate.
 struct RecommendedCalibration {
   std::vector<double> time_offset_s;  // per IMU [s]

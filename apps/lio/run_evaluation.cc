@@ -172,8 +172,8 @@ void WriteCalibrationOutputs(const std::string& out, const RunSummary& run,
     for (const std::string& n : recommended->kept_at_start) {
       names += " " + n;
     }
-    LOG(WARNING) << "Calibration: sigma not below the threshold (the data did not inform "
-                    "them), written at their start values in "
+    LOG(WARNING) << "Calibration: not informed by the data (sigma near the prior's, or flagged "
+                    "unobservable on most scans), written at their start values in "
                  << out << "/calibration.yaml:" << names;
   }
   WriteTimeOffsetEvaluation(run, ev);

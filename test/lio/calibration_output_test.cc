@@ -1,8 +1,10 @@
 // The calibration a run recommends for a config (calibration_output.h,
 // docs/user-guide/calibration.md): per coordinate the estimate where its σ is below the threshold
-// of its kind (calibration.write_max_sigma_*), else the start, whatever share of scans the
-// observability check flagged; calibration.yaml shows estimate, σ, start, written value and why
-// per coordinate and works as an overlay after the config. On constructed runs, and end to end in
+// of its kind (calibration.write_max_sigma_*) whatever share of scans the observability check
+// flagged, or where the data informed it (σ at most write_max_sigma_ratio of the prior σ and
+// flagged after at most write_max_unobservable_fraction of the scans), else the start;
+// calibration.yaml shows estimate, σ, prior σ, start, written value and why per coordinate and
+// works as an overlay after the config. On constructed runs with known values, and end to end in
 // the slow regime (translation only).
 #include "lio/calibration_output.h"
 
@@ -71,18 +73,21 @@ SE3 Estimate() {
   return SE3::Exp(x) * Start();
 }
 
-// σ per extrinsic coordinate [ρ (m); φ (rad)]: ρ_x 5 mm, φ_z 0.05° below their thresholds (1 cm,
-// 0.1°); ρ_y 2 cm, φ_x 0.3° above; ρ_z exactly 1 cm and φ_y 0.1° (not below: kept).
+// σ per extrinsic coordinate [ρ (m); φ (rad)], against the default thresholds (1 cm, 0.1°) and
+// prior σ (20 cm, 5°): ρ_x 5 mm and φ_z 0.05° below the thresholds; ρ_y and ρ_z 1.5 cm (0.075 of
+// the prior's) and φ_x 0.3° (0.06, walking's case) above them but informed; φ_y 1° (0.2 of the
+// prior's: uninformed).
 Vec6 MixedSigma() {
   Vec6 s;
-  s << 0.005, 0.02, 0.01, 0.3 * kDeg, 0.1 * kDeg, 0.05 * kDeg;
+  s << 0.005, 0.015, 0.015, 0.3 * kDeg, 1.0 * kDeg, 0.05 * kDeg;
   return s;
 }
 
 // 101 scans, 100 assessed, δ started at 2 ms with σ 0.2 ms (below 0.5 ms) but flagged
-// unobservable on 81 of them (issue 45's case); ρ_x flagged on all, φ_z on 90; ρ_y, φ_x never.
+// unobservable on 81 of them (issue 45's case); ρ_x flagged on all, φ_z on 90, ρ_z on 60 (more
+// than half: its small σ is contradicted); ρ_y, φ_x, φ_y never.
 RunSummary FlaggedButInformedRun() {
-  return ConstructedRun(101, {82, 101, 0, 51, 0, 0, 91}, 0.002, Start(), Estimate(), 2e-4,
+  return ConstructedRun(101, {82, 101, 0, 61, 0, 0, 91}, 0.002, Start(), Estimate(), 2e-4,
                         MixedSigma());
 }
 
@@ -102,10 +107,10 @@ TEST(CalibrationOutput, AnEstimateWithSmallSigmaIsWrittenWhateverShareWasFlagged
   const RunSummary run = FlaggedButInformedRun();
   const auto r = RecommendCalibration(run, lio::CalibrationOptions());
   ASSERT_TRUE(r.has_value());
-  // δ (flagged on 81%, σ 0.2 ms), ρ_x (flagged on 100%, σ 5 mm) and φ_z (90%, 0.05°) are
-  // written; ρ_y (never flagged, σ 2 cm), φ_x (never, 0.3°) and the two at their threshold not.
-  EXPECT_EQ(r->kept_at_start, (std::vector<std::string>{"extrinsic_rho_y", "extrinsic_rho_z",
-                                                        "extrinsic_phi_x", "extrinsic_phi_y"}));
+  // Below the thresholds, written whatever was flagged: δ (81%, σ 0.2 ms), ρ_x (100%, 5 mm),
+  // φ_z (90%, 0.05°). Above them, informed and not flagged on most scans: ρ_y (1.5 cm), φ_x
+  // (0.3°). Kept: ρ_z (informed by σ but flagged on 60% of the scans), φ_y (0.2 of the prior).
+  EXPECT_EQ(r->kept_at_start, (std::vector<std::string>{"extrinsic_rho_z", "extrinsic_phi_y"}));
   ASSERT_EQ(r->time_offset_s.size(), 1u);
   EXPECT_EQ(r->time_offset_s[0], 0.0123);
   ASSERT_EQ(r->coordinates.size(), 7u);
@@ -117,36 +122,69 @@ TEST(CalibrationOutput, AnEstimateWithSmallSigmaIsWrittenWhateverShareWasFlagged
   // written ones the estimate's.
   const Vec6 moved = (estimate * start.Inverse()).Log();
   const Vec6 written = (r->T_imu_lidar * start.Inverse()).Log();
-  for (int i : {1, 2, 3, 4}) {
+  for (int i : {2, 4}) {
     EXPECT_NEAR(written[i], 0.0, 1e-12) << i;
   }
-  for (int i : {0, 5}) {
+  for (int i : {0, 1, 3, 5}) {
     EXPECT_NEAR(written[i], moved[i], 1e-12) << i;
   }
+  // The prior σ of each kind, in the coordinates' SI units, and the reasons per branch.
+  EXPECT_DOUBLE_EQ(r->coordinates[0].prior_sigma, 0.03);
+  EXPECT_DOUBLE_EQ(r->coordinates[2].prior_sigma, 0.2);
+  EXPECT_DOUBLE_EQ(r->coordinates[4].prior_sigma, 5.0 * kDeg);
+  EXPECT_NE(r->coordinates[2].reason.find("informed it, sigma 0.075 of the prior's"),
+            std::string::npos)
+      << r->coordinates[2].reason;
+  EXPECT_NE(r->coordinates[3].reason.find("flagged unobservable after more than 50%"),
+            std::string::npos)
+      << r->coordinates[3].reason;
+  EXPECT_NE(r->coordinates[5].reason.find("sigma 0.2 of the prior's"), std::string::npos)
+      << r->coordinates[5].reason;
+  EXPECT_NE(r->coordinates[5].reason.find("did not inform"), std::string::npos);
+  // Both conditions are the config's: the ratio 0 leaves the thresholds alone (the rule before);
+  // a share of 0.7 admits ρ_z (60%); a ratio of 0.25 admits φ_y (0.2).
+  const auto kept = [&](const lio::CalibrationOptions& o) {
+    return RecommendCalibration(run, o)->kept_at_start;
+  };
+  lio::CalibrationOptions o;
+  o.write_max_sigma_ratio = 0.0;
+  EXPECT_EQ(kept(o), (std::vector<std::string>{"extrinsic_rho_y", "extrinsic_rho_z",
+                                               "extrinsic_phi_x", "extrinsic_phi_y"}));
+  o = lio::CalibrationOptions();
+  o.write_max_unobservable_fraction = 0.7;
+  EXPECT_EQ(kept(o), (std::vector<std::string>{"extrinsic_phi_y"}));
+  o = lio::CalibrationOptions();
+  o.write_max_sigma_ratio = 0.25;
+  EXPECT_EQ(kept(o), (std::vector<std::string>{"extrinsic_rho_z"}));
 }
 
 TEST(CalibrationOutput, AnEstimateWithLargeSigmaKeepsTheStart) {
-  // δ with σ 1 ms, never flagged: the start (2 ms); every extrinsic σ 2 cm / 0.5°: the start.
+  // Never flagged, σ a sixth to a quarter of the prior's (30 ms, 20 cm, 5°), above the thresholds
+  // and the ratio: δ with σ 5 ms keeps the start (2 ms); every extrinsic σ 5 cm / 1°: the start.
   Vec6 sigma;
-  sigma << 0.02, 0.02, 0.02, 0.5 * kDeg, 0.5 * kDeg, 0.5 * kDeg;
+  sigma << 0.05, 0.05, 0.05, 1.0 * kDeg, 1.0 * kDeg, 1.0 * kDeg;
   const RunSummary run =
-      ConstructedRun(11, {0, 0, 0, 0, 0, 0, 0}, 0.002, Start(), Estimate(), 1e-3, sigma);
+      ConstructedRun(11, {0, 0, 0, 0, 0, 0, 0}, 0.002, Start(), Estimate(), 5e-3, sigma);
   const auto r = RecommendCalibration(run, lio::CalibrationOptions());
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->kept_at_start.size(), 7u);
   EXPECT_EQ(r->time_offset_s[0], 0.002);
   EXPECT_TRUE((r->T_imu_lidar * Start().Inverse()).Log().norm() < 1e-12);
   EXPECT_NE(r->coordinates[0].reason.find("did not inform"), std::string::npos);
-  // The thresholds are the config's: 2 ms, 1°, 5 cm write them all.
+  // The thresholds are the config's: 10 ms, 2°, 10 cm write them all; so does a ratio of 0.3.
   lio::CalibrationOptions loose;
-  loose.write_max_sigma_s = 2e-3;
-  loose.write_max_sigma_deg = 1.0;
-  loose.write_max_sigma_m = 0.05;
-  const auto w = RecommendCalibration(run, loose);
-  ASSERT_TRUE(w.has_value());
-  EXPECT_TRUE(w->kept_at_start.empty());
-  EXPECT_EQ(w->time_offset_s[0], 0.0123);
-  EXPECT_TRUE((w->T_imu_lidar * Estimate().Inverse()).Log().norm() < 1e-12);
+  loose.write_max_sigma_s = 1e-2;
+  loose.write_max_sigma_deg = 2.0;
+  loose.write_max_sigma_m = 0.1;
+  lio::CalibrationOptions ratio;
+  ratio.write_max_sigma_ratio = 0.3;
+  for (const lio::CalibrationOptions& o : {loose, ratio}) {
+    const auto w = RecommendCalibration(run, o);
+    ASSERT_TRUE(w.has_value());
+    EXPECT_TRUE(w->kept_at_start.empty());
+    EXPECT_EQ(w->time_offset_s[0], 0.0123);
+    EXPECT_TRUE((w->T_imu_lidar * Estimate().Inverse()).Log().norm() < 1e-12);
+  }
   // Asked not to keep: the last estimate as it is.
   const auto raw = RecommendCalibration(run, lio::CalibrationOptions(), false);
   ASSERT_TRUE(raw.has_value());
@@ -167,8 +205,8 @@ TEST(CalibrationOutput, NoSigmaKeepsTheStart) {
   EXPECT_NE(r->coordinates[3].reason.find("no sigma"), std::string::npos);
 }
 
-// calibration.yaml: per coordinate one block, top-down estimate, σ, start, written, why (and the
-// share flagged as information); the keys are the recommendation, and the file is an overlay
+// calibration.yaml: per coordinate one block, top-down estimate, σ, prior σ, start, share flagged,
+// written, why; the keys are the recommendation, and the file is an overlay
 // that gives a config the written calibration.
 TEST(CalibrationOutput, TheYamlShowsEachCoordinateTopDownAndIsAnOverlay) {
   const RunSummary run = FlaggedButInformedRun();
@@ -185,23 +223,28 @@ TEST(CalibrationOutput, TheYamlShowsEachCoordinateTopDownAndIsAnOverlay) {
   };
   const std::string delta = block("time_offset_0");
   std::vector<size_t> order;
-  for (const char* line : {"#   estimate   12.3\n", "#   sigma      0.2\n", "#   start      2\n",
-                           "#   written    12.3\n", "#   why        the estimate"}) {
+  for (const char* line :
+       {"#   estimate     12.3\n", "#   sigma        0.2\n", "#   prior sigma  30\n",
+        "#   start        2\n", "#   flagged      unobservable after 81% of the scans",
+        "#   written      12.3\n", "#   why          the estimate"}) {
     order.push_back(delta.find(line));
     EXPECT_NE(order.back(), std::string::npos) << line << "\n" << delta;
   }
   EXPECT_TRUE(std::is_sorted(order.begin(), order.end())) << delta;
   EXPECT_NE(delta.find("threshold, 0.5 ms (calibration.write_max_sigma_s)\n"), std::string::npos)
       << delta;
-  EXPECT_NE(delta.find("flagged unobservable after 81% of the scans"), std::string::npos) << delta;
-  const std::string rho_y = block("extrinsic_rho_y");  // cm
-  EXPECT_NE(rho_y.find("#   sigma      2\n"), std::string::npos) << rho_y;
-  EXPECT_NE(rho_y.find("#   start      0\n#   written    0\n"), std::string::npos) << rho_y;
-  EXPECT_NE(rho_y.find("threshold, 1 cm (calibration.write_max_sigma_m): the data did not inform"),
+  const std::string phi_y = block("extrinsic_phi_y");  // deg
+  EXPECT_NE(phi_y.find("#   sigma        1\n#   prior sigma  5\n#   start        0\n"),
             std::string::npos)
+      << phi_y;
+  EXPECT_NE(phi_y.find("#   written      0\n"), std::string::npos) << phi_y;
+  EXPECT_NE(phi_y.find("0.1 deg (calibration.write_max_sigma_deg): the data did not inform"),
+            std::string::npos)
+      << phi_y;
+  const std::string rho_y = block("extrinsic_rho_y");  // cm, informed
+  EXPECT_NE(rho_y.find("#   sigma        1.5\n#   prior sigma  20\n"), std::string::npos) << rho_y;
+  EXPECT_NE(rho_y.find("(at most 0.1, calibration.write_max_sigma_ratio)"), std::string::npos)
       << rho_y;
-  EXPECT_NE(block("extrinsic_phi_x").find("0.1 deg (calibration.write_max_sigma_deg)"),
-            std::string::npos);
   EXPECT_EQ(text.find("NOT CALIBRATED"), std::string::npos);
   // What a config reads from it is the recommendation (9 significant digits).
   const YAML::Node y = YAML::LoadFile(path);
@@ -220,25 +263,24 @@ TEST(CalibrationOutput, TheYamlShowsEachCoordinateTopDownAndIsAnOverlay) {
   EXPECT_LT((c.T_imu_lidar * r->T_imu_lidar.Inverse()).Log().norm(), 1e-7);
   std::ostringstream summary;
   WriteObservabilitySummary(run, r, summary);
-  EXPECT_NE(summary.str().find("calibration_kept_at_start extrinsic_rho_y extrinsic_rho_z "
-                               "extrinsic_phi_x extrinsic_phi_y\n"),
+  EXPECT_NE(summary.str().find("calibration_kept_at_start extrinsic_rho_z extrinsic_phi_y\n"),
             std::string::npos)
       << summary.str();
 }
 
-TEST(CalibrationOutput, WithoutTheObservabilityCheckTheRuleIsTheSame) {
+// Without the observability check σ alone decides: ρ_z (flagged on 60% above) is written.
+TEST(CalibrationOutput, WithoutTheObservabilityCheckSigmaAloneDecides) {
   const RunSummary run = ConstructedRun(5, {}, 0.0, Start(), Estimate(), 2e-4, MixedSigma());
   const auto r = RecommendCalibration(run, lio::CalibrationOptions());
   ASSERT_TRUE(r.has_value());
-  EXPECT_EQ(r->kept_at_start.size(), 4u);
+  EXPECT_EQ(r->kept_at_start, (std::vector<std::string>{"extrinsic_phi_y"}));
+  EXPECT_NE(r->coordinates[3].reason.find("no observability check"), std::string::npos);
   EXPECT_EQ(r->time_offset_s[0], 0.0123);
   const auto [path, text] = WrittenYaml(run, *r);
-  EXPECT_EQ(text.find("flagged"), std::string::npos) << text;
+  EXPECT_EQ(text.find("#   flagged"), std::string::npos) << text;
   std::ostringstream summary;
   WriteObservabilitySummary(run, r, summary);
-  EXPECT_EQ(summary.str(),
-            "calibration_kept_at_start extrinsic_rho_y extrinsic_rho_z "
-            "extrinsic_phi_x extrinsic_phi_y\n");
+  EXPECT_EQ(summary.str(), "calibration_kept_at_start extrinsic_phi_y\n");
 }
 
 // Slow regime (translation only), both calibrations from the wrong start, the default (not held)

@@ -70,12 +70,13 @@ TEST(ExtrinsicCalibration, ConvergesFromAWrongStartAndSigmaShrinks) {
       sim::CoveredBySigma(last.calibration.T_imu_lidar, c.imu_from_lidar, s);
   EXPECT_TRUE(covered.rotation);
   EXPECT_TRUE(covered.translation);
-  // A static state: every marginalisation keeps it, and the lidar residuals read it.
+  // A static state: every marginalisation keeps it, and the lidar residuals read it: with the
+  // default residual_blocks ("square_root") one batch per knot interval of the newest scan
+  // besides the marginal prior (ContinuousLidarTerm::batched).
   EXPECT_GT(odometry->num_marginalizations(), 10);
   const std::vector<StateId>& kept = odometry->last_marginalization().kept;
   EXPECT_NE(std::find(kept.begin(), kept.end(), kExtrinsicKey), kept.end());
-  EXPECT_GE(static_cast<int>(odometry->window().ResidualBlocksOf(kExtrinsicKey).size()),
-            last.associations);
+  EXPECT_GE(odometry->window().ResidualBlocksOf(kExtrinsicKey).size(), 2u);
 }
 
 // The reported marginal σ of the calibration states (the Schur complement of the whole window's

@@ -87,7 +87,10 @@ TEST(LioPipeline, FrontendThreadsAndVoxelPlanes) {
 // per-point blocks' estimates up to rounding — the same associations, statuses and degeneracy
 // analysis (which linearises the lidar blocks), poses within 1e-7 m / 1e-7 rad (measured: <= 2e-9
 // m) — with one and two knots per sweep. With the extrinsic estimated (knots = 0 below: one knot,
-// online calibration) the residuals stay per keypoint: the same run bit for bit.
+// online calibration) the batch's extrinsic form: the same cost, gradient and Hessian up to
+// rounding, which the calibrating window's nearly singular first marginal prior amplifies
+// (continuous_lidar_term.h) in this 1 s start: the poses differ by up to ~1 cm, with no
+// systematic difference (the ATE within 10%).
 TEST(LioPipeline, IntervalResidualBlocksGiveThePerPointEstimates) {
   for (const std::string blocks : {"interval", "square_root"}) {
     for (const int knots : {1, 2, 0}) {
@@ -102,12 +105,21 @@ TEST(LioPipeline, IntervalResidualBlocksGiveThePerPointEstimates) {
       const lioapp::RunSummary a = lioapp::RunOdometry(point_source, point);
       sim::SimulatedSource interval_source(sequence);
       const lioapp::RunSummary b = lioapp::RunOdometry(interval_source, interval);
+      if (knots == 0) {
+        // Measured: ATE 2.06 cm per point against 2.11 (interval) and 2.02 cm (square root).
+        ASSERT_TRUE(a.ate.has_value() && b.ate.has_value());
+        EXPECT_NEAR(b.ate->rmse, a.ate->rmse, 0.1 * a.ate->rmse) << blocks;
+      }
       ASSERT_EQ(a.trajectory.size(), 10u);
       ASSERT_EQ(a.trajectory.size(), b.trajectory.size());
       for (size_t i = 0; i < a.trajectory.size(); ++i) {
         SCOPED_TRACE(blocks + ", knots " + std::to_string(knots) + ", scan " + std::to_string(i));
         const Vec6 d = (b.trajectory[i].pose * a.trajectory[i].pose.Inverse()).Log();
-        if (knots == 0) EXPECT_EQ(a.trajectory[i].pose.Matrix(), b.trajectory[i].pose.Matrix());
+        if (knots == 0) {  // measured: <= 1.3 cm and 6e-4 rad, growing from 2e-6 m at scan 2
+          EXPECT_LT(d.head<3>().norm(), 0.02);
+          EXPECT_LT(d.tail<3>().norm(), 2e-3);
+          continue;
+        }
         EXPECT_LT(d.head<3>().norm(), 1e-7);
         EXPECT_LT(d.tail<3>().norm(), 1e-7);
         EXPECT_EQ(a.scans[i].associations, b.scans[i].associations);

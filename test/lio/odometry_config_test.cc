@@ -531,6 +531,20 @@ TEST(OdometryConfigComposition, WriteThresholdKeys) {
               std::string::npos)
         << m;
   }
+  // The informed-estimate rule's two keys; out of range, an error naming the key.
+  const OdometryConfig r =
+      LoadOdometryConfig(WriteTemp("write_ratio.yaml",
+                                   "calibration:\n  write_max_sigma_ratio: 0.2\n"
+                                   "  write_max_unobservable_fraction: 0.3\n"));
+  EXPECT_DOUBLE_EQ(r.calibration.write_max_sigma_ratio, 0.2);
+  EXPECT_DOUBLE_EQ(r.calibration.write_max_unobservable_fraction, 0.3);
+  EXPECT_DOUBLE_EQ(OdometryConfig().calibration.write_max_sigma_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(OdometryConfig().calibration.write_max_unobservable_fraction, 0.5);
+  for (const std::string key : {"write_max_sigma_ratio", "write_max_unobservable_fraction"}) {
+    const std::string m =
+        LoadError(WriteTemp("write_ratio_bad.yaml", "calibration:\n  " + key + ": 1.5\n"));
+    EXPECT_NE(m.find("calibration." + key + " must be in"), std::string::npos) << m;
+  }
 }
 
 // The translation of `extrinsic:` wins over xyz_rpy's whatever the key order, so a written

@@ -44,6 +44,14 @@ void CalibrationOptions::Validate() const {
   for (double t : {write_max_sigma_s, write_max_sigma_deg, write_max_sigma_m}) {
     require(std::isfinite(t) && t > 0, "calibration.write_max_sigma_* must be finite and > 0");
   }
+  // 0 turns the ratio off (the thresholds alone); 1 would call an estimate no better than its
+  // prior informed.
+  require(std::isfinite(write_max_sigma_ratio) && write_max_sigma_ratio >= 0 &&
+              write_max_sigma_ratio < 1,
+          "calibration.write_max_sigma_ratio must be in [0, 1) (0: the thresholds alone)");
+  require(std::isfinite(write_max_unobservable_fraction) && write_max_unobservable_fraction >= 0 &&
+              write_max_unobservable_fraction <= 1,
+          "calibration.write_max_unobservable_fraction must be in [0, 1]");
   require(!(warmup_replay_hold && warmup_replay_freeze),
           "calibration.warmup_replay_hold and warmup_replay_freeze: choose one for the last pass");
 }

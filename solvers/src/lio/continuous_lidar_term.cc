@@ -114,7 +114,6 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
                                             const std::shared_ptr<const ceres::LossFunction>& loss,
                                             SlidingWindow* window,
                                             std::vector<ceres::ResidualBlockId>* blocks) {
-  // batched() excludes the extrinsic: the blocks are on the interval's knots only.
   if (!batched()) throw std::logic_error("ContinuousLidarTerm::SetBatchResiduals: not batched");
   for (ceres::ResidualBlockId id : *blocks) window->RemoveResidualBlock(id);
   blocks->clear();
@@ -124,7 +123,9 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
     if (!associated[i]) continue;
     const std::shared_ptr<SharedPoseInterpolation>& firing = firings_[firing_[i]];
     firing->set_active(true);  // a residual reads it in this round's solve
-    points[static_cast<size_t>(interval_of(i))].push_back({firing, planes[i]});
+    // With the extrinsic the row is ContinuousPointToPlaneExtrinsic's, of the lidar-frame point.
+    points[static_cast<size_t>(interval_of(i))].push_back(
+        {firing, planes[i], extrinsic_ != nullptr ? points_lidar_[i] : Vec3::Zero()});
   }
   for (size_t j = 0; j < points.size(); ++j) {
     if (points[j].empty()) continue;
@@ -134,8 +135,8 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
                                                                                 : Form::kPointRows;
     // A few hundred rows are worth a second thread (~0.1 ms each per evaluation); a handful not.
     const bool worth_threads = points[j].size() >= 128;
-    auto* batch = new ContinuousPointToPlaneBatch(std::move(points[j]), loss,
-                                                  /*with_extrinsic=*/false, form);
+    auto* batch =
+        new ContinuousPointToPlaneBatch(std::move(points[j]), loss, extrinsic_ != nullptr, form);
     if (const int threads = window->options().threads; threads > 1 && worth_threads) {
       // In the window's solve only (SlidingWindow::solving).
       batch->set_row_runner(
@@ -144,7 +145,9 @@ void ContinuousLidarTerm::SetBatchResiduals(const std::vector<uint8_t>& associat
                         [&](size_t, size_t begin, size_t end) { rows(begin, end); });
           });
     }
-    blocks->push_back(window->AddResidualBlock(batch, nullptr, states_[j]));
+    std::vector<StateId> states = states_[j];
+    if (extrinsic_ != nullptr) states.push_back(kExtrinsicKey);
+    blocks->push_back(window->AddResidualBlock(batch, nullptr, states));
   }
 }
 

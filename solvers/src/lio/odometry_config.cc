@@ -296,7 +296,9 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"write_max_sigma_deg",
             SetPositive(&o.write_max_sigma_deg, source, section + ".write_max_sigma_deg")},
            {"write_max_sigma_m",
-            SetPositive(&o.write_max_sigma_m, source, section + ".write_max_sigma_m")}});
+            SetPositive(&o.write_max_sigma_m, source, section + ".write_max_sigma_m")},
+           {"write_max_sigma_ratio", SetFromYaml(&o.write_max_sigma_ratio)},
+           {"write_max_unobservable_fraction", SetFromYaml(&o.write_max_unobservable_fraction)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

@@ -98,6 +98,17 @@ struct CalibrationOptions {
   double write_max_sigma_s = 5e-4;   // time offset δ_j [s]
   double write_max_sigma_deg = 0.1;  // extrinsic rotation φ per axis [deg]
   double write_max_sigma_m = 0.01;   // extrinsic translation ρ per axis [m]
+  // Above its threshold, an estimate is still written when the data informed it: its σ is at
+  // most `write_max_sigma_ratio` of its prior σ (0.1: ≥ 99 priors' worth of information, since
+  // information ∝ 1/σ²) and the observability check flagged it after at most
+  // `write_max_unobservable_fraction` of the assessed scans. Why the second condition: in
+  // translation-only motion the window's σ of a drifting coordinate is small as well (δ 1.1 ms
+  // of a 30 ms prior while 12 ms off: the marginal prior's information counted again each
+  // slide), and the check flags it after 90–100% of the scans, where gentle motion's informed
+  // axes (σ 0.11–0.23° of a 5° prior, within 0.05°) are flagged after 0%.
+  // docs/experiments/calibration.md, "The write rule".
+  double write_max_sigma_ratio = 0.1;
+  double write_max_unobservable_fraction = 0.5;
 
   // Set by the held pass of a warm-up replay, not read from YAML: C_mi stays held (as with
   // window.estimate_gravity false and no extrinsic estimated) although the extrinsic is

@@ -64,18 +64,23 @@ class ContinuousLidarTerm final : public LidarTerm {
   // As LidarFrontendOptions::residual_blocks: "point", one block per keypoint; "interval" and
   // "square_root" batch the keypoints of each knot interval into one ContinuousPointToPlaneBatch
   // of point rows or in square-root form (that only where it has fewer rows: more than W + 1 = 37
-  // points). Not with the extrinsic estimated: batched() is then false and the residuals stay per
-  // keypoint, so the calibration results stay those measured. (The batch's extrinsic form matches
-  // the per-point factors' cost, gradient and Hessian; in a calibrating window the first marginal
-  // prior is nearly singular along pose–extrinsic directions just above the rank threshold, and its
-  // residual r0 there amplifies rounding — Sᵀr0 equal to 1e-11, ‖r0‖ 1.109 vs 1.160 — so on
-  // sparse 1 s runs the two diverge by millimetres, on a 3 s full-firing run by 1e-7 m.)
+  // points). Also with the extrinsic estimated (the batch's extrinsic form, a seventh block T_rl):
+  // per keypoint, the extrinsic's blocks cost a calibrating scan ~2.5x the CPU of the same scan
+  // without calibration, most of it Ceres' per-block work in the solve and the marginalisation
+  // (docs/experiments/calibration.md, "CPU per calibrating scan"). The batch matches the
+  // per-point factors' cost, gradient and Hessian up to rounding; in a calibrating window the
+  // first marginal prior is nearly singular along pose–extrinsic directions just above the rank
+  // threshold, and its residual r0 there amplifies rounding (Sᵀr0 equal to 1e-11, ‖r0‖ 1.109 vs
+  // 1.160), so the two differ by up to ~1 cm in a sparse run's first second (ATE 2.06 cm per
+  // keypoint, 2.02–2.11 batched: lio.LioPipeline.IntervalResidualBlocksGiveThePerPointEstimates)
+  // and within noise over 20 s (docs/experiments/calibration.md); "point" keeps the per-keypoint
+  // blocks.
   void set_residual_blocks(const std::string& residual_blocks) {
     batched_ = residual_blocks == "interval" || residual_blocks == "square_root";
     batch_form_ = residual_blocks == "square_root" ? ContinuousPointToPlaneBatch::Form::kSquareRoot
                                                    : ContinuousPointToPlaneBatch::Form::kPointRows;
   }
-  bool batched() const override { return batched_ && extrinsic_ == nullptr; }
+  bool batched() const override { return batched_; }
   void SetBatchResiduals(const std::vector<uint8_t>& associated,
                          const std::vector<PlaneAssociation>& planes,
                          const std::shared_ptr<const ceres::LossFunction>& loss,
