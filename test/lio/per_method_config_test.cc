@@ -87,5 +87,28 @@ TEST(PerMethodConfig, ErrorsNameFileAndLine) {
                std::runtime_error);
 }
 
+// The covariance-only lidar variance scale (issue 43): per method, the others keep 1 (the window
+// as solved); a scale that is not positive is an error naming the key.
+TEST(PerMethodConfig, PoseCovarianceLidarScaleIsPerMethodAndPositive) {
+  const OdometryConfig c =
+      LoadOdometryConfig(WriteTemp("pcl.yaml",
+                                   "per_method:\n"
+                                   "  singer_lio: {window: {pose_covariance_lidar_scale: 0.1}}\n"));
+  EXPECT_DOUBLE_EQ(c.pose_covariance_lidar_scale, 1.0);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_lidar_scale, 0.1);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_scale, 1.0);
+  for (const char* bad : {"0", "-2", ".nan"}) {
+    const std::string path = WriteTemp(
+        "pcl_bad.yaml", std::string("window:\n  pose_covariance_lidar_scale: ") + bad + "\n");
+    try {
+      LoadOdometryConfig(path);
+      ADD_FAILURE() << "expected an error for " << bad;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("pose_covariance_lidar_scale"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio

@@ -251,17 +251,23 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map += MsSince(t_map);
   estimator_->Report(result);
-  if (config_.pose_covariance) ReportPoseCovariance(result);
+  if (config_.pose_covariance) ReportPoseCovariance(registered.lidar_blocks, result);
   calibration_.Report(estimator_->NewestKeys(), &window_, result);
 }
 
-void LioOdometry::ReportPoseCovariance(ScanResult* result) {
-  // Not rescaled by the lidar term's own χ² (ScaledPoseCovariance, LidarChiSquareScale): on the
-  // tuning sequences that made the baseline 40x overconfident (docs/experiments/covariance.md).
-  // A rank-deficient window gives no covariance (the scan then has none).
+void LioOdometry::ReportPoseCovariance(const std::vector<ceres::ResidualBlockId>& lidar,
+                                       ScanResult* result) {
+  // Not rescaled by the lidar term's own χ² (LidarChiSquareScale): on the tuning sequences that
+  // made the baseline 40x overconfident (docs/experiments/covariance.md). A fixed scale of the
+  // lidar variance (pose_covariance_lidar_scale) is a per-method setting instead. A
+  // rank-deficient window gives no covariance (the scan then has none).
+  const StateId pose = estimator_->NewestPoseKey();
+  const double scale = config_.pose_covariance_lidar_scale;
   const std::optional<Mat6> S =
-      PoseCovariance(&window_.problem(), window_.State(estimator_->NewestPoseKey()), result->T_mr,
-                     estimator_->NewestPoseTangentFromBody());
+      scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
+                                    estimator_->NewestPoseTangentFromBody())
+                   : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
+                                          estimator_->NewestPoseTangentFromBody());
   if (!S) return;
   result->pose_covariance = *S;
   result->has_pose_covariance = true;

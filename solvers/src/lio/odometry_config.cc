@@ -144,6 +144,7 @@ void OdometryConfig::Validate() const {
   require(gap_velocity_walk > 0, "imu.gap_velocity_walk must be positive");
   require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
+  require(pose_covariance_lidar_scale > 0, "window.pose_covariance_lidar_scale must be positive");
   require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
           "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
@@ -248,7 +249,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"overlap", SetFromYaml(&c->overlap_stages)},
            {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
            {"imu_prediction", SetFromYaml(&c->imu_prediction)},
-           {"pose_covariance", SetFromYaml(&c->pose_covariance)}});
+           {"pose_covariance", SetFromYaml(&c->pose_covariance)},
+           {"pose_covariance_lidar_scale", SetFromYaml(&c->pose_covariance_lidar_scale)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

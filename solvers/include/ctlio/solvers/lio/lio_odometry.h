@@ -122,7 +122,8 @@ class LioOdometry {
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
-  void ReportPoseCovariance(ScanResult* result);
+  // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
+  void ReportPoseCovariance(const std::vector<ceres::ResidualBlockId>& lidar, ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;

@@ -155,6 +155,12 @@ struct OdometryConfig {
   // window at the solution) into ScanResult::pose_covariance (window.pose_covariance). Off by
   // default: it costs one more Jacobian evaluation and a factorisation per scan.
   bool pose_covariance = false;
+  // The lidar residuals' variance in that covariance only, as a multiple of point_noise_sigma²
+  // (window.pose_covariance_lidar_scale; the estimate is unchanged). 1: the window as solved
+  // (ceres::Covariance); else its dense Gauss–Newton information with the newest scan's lidar
+  // blocks divided by it (ScaledPoseCovariance). For a lidar σ that weighs the estimate well but
+  // overstates the pose's spread (docs/experiments/covariance.md).
+  double pose_covariance_lidar_scale = 1.0;
 
   // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
   // every one). Bounded so that the pipeline's memory does not grow with the length of the run
