@@ -15,6 +15,7 @@
 #include "ctlio/io/sim_folder.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "io/same_frames.h"
 #include "lio/run_odometry.h"
 
 namespace ctlio::io {
@@ -74,31 +75,8 @@ std::string StorageFile(const fs::path& folder) {
 
 void ExpectSameFrames(DataSource& expected, DataSource& read) {
   EXPECT_EQ(read.ImuFromLidar().Matrix(), expected.ImuFromLidar().Matrix());
-  ScanFrame a, b;
-  size_t n = 0;
-  while (expected.Next(&a)) {
-    ASSERT_TRUE(read.Next(&b)) << "scan " << n;
-    EXPECT_EQ(a.start_ns, b.start_ns);
-    EXPECT_EQ(a.end_ns, b.end_ns);
-    EXPECT_EQ(a.cloud.points, b.cloud.points) << "scan " << n;
-    EXPECT_EQ(a.cloud.times_ns, b.cloud.times_ns) << "scan " << n;
-    ASSERT_EQ(a.imu.size(), b.imu.size()) << "scan " << n;
-    for (size_t i = 0; i < a.imu.size(); ++i) {
-      EXPECT_EQ(a.imu[i].t_ns, b.imu[i].t_ns);
-      EXPECT_EQ(a.imu[i].gyro, b.imu[i].gyro);
-      EXPECT_EQ(a.imu[i].accel, b.imu[i].accel);
-    }
-    ++n;
-  }
-  EXPECT_FALSE(read.Next(&b));
-  EXPECT_GE(n, 7u);
-  const auto gt_a = expected.GroundTruth(), gt_b = read.GroundTruth();
-  ASSERT_TRUE(gt_a && gt_b);
-  ASSERT_EQ(gt_a->size(), gt_b->size());
-  for (size_t i = 0; i < gt_a->size(); ++i) {
-    EXPECT_EQ((*gt_a)[i].t_ns, (*gt_b)[i].t_ns);
-    EXPECT_LT(((*gt_a)[i].pose.Matrix() - (*gt_b)[i].pose.Matrix()).norm(), 1e-12);
-  }
+  EXPECT_GE(testing::ExpectSameFrames(expected, read), 7u);
+  EXPECT_TRUE(expected.GroundTruth() && read.GroundTruth());
 }
 
 TEST(Ros2BagTrajectory, EveryLayoutHandsTheOdometryTheSameFrames) {

@@ -18,6 +18,7 @@
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/sim/presets.h"
 #include "ctlio/sim/sensor_models.h"
+#include "io/same_frames.h"
 
 namespace ctlio::io {
 namespace {
@@ -128,7 +129,8 @@ TEST(SensorBags, EachDriverReadsTheSameFromRos1AndRos2Bags) {
       sim::SimulatedSource written(SensorSim(sensor));
       ASSERT_EQ(WriteRosbag(written, ros1, wo), 5u);
     }
-    for (const ros2::Ros2Storage storage : {ros2::Ros2Storage::kMcap, ros2::Ros2Storage::kSqlite3}) {
+    for (const ros2::Ros2Storage storage :
+         {ros2::Ros2Storage::kMcap, ros2::Ros2Storage::kSqlite3}) {
       const std::string ros2_bag =
           (d / (sensor + (storage == ros2::Ros2Storage::kMcap ? "_mcap" : "_db3"))).string();
       {
@@ -144,23 +146,7 @@ TEST(SensorBags, EachDriverReadsTheSameFromRos1AndRos2Bags) {
       BagSource a(ros1, ro), b(ros2_bag, ro);
       EXPECT_EQ(a.lidar_topic(), b.lidar_topic());
       EXPECT_EQ(b.Name().rfind("ros2bag:", 0), 0u);
-      ScanFrame fa, fb;
-      size_t n = 0;
-      while (a.Next(&fa)) {
-        ASSERT_TRUE(b.Next(&fb)) << "scan " << n;
-        EXPECT_EQ(fa.start_ns, fb.start_ns);
-        EXPECT_EQ(fa.end_ns, fb.end_ns);
-        EXPECT_EQ(fa.cloud.points, fb.cloud.points) << "scan " << n;
-        EXPECT_EQ(fa.cloud.times_ns, fb.cloud.times_ns) << "scan " << n;
-        ASSERT_EQ(fa.imu.size(), fb.imu.size()) << "scan " << n;
-        for (size_t i = 0; i < fa.imu.size(); ++i) {
-          EXPECT_EQ(fa.imu[i].t_ns, fb.imu[i].t_ns);
-          EXPECT_EQ(fa.imu[i].accel, fb.imu[i].accel);
-        }
-        ++n;
-      }
-      EXPECT_FALSE(b.Next(&fb));
-      EXPECT_EQ(n, 5u);
+      EXPECT_EQ(testing::ExpectSameFrames(a, b), 5u);
     }
   }
 }
