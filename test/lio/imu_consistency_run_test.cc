@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/mutated_source.h"
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "lio/run_checks.h"
@@ -86,38 +87,13 @@ TEST(ImuConsistency, TheMedianOverTheMovingScansIsJudged) {
   EXPECT_NE(c.warning.find("imu.gyro_variance"), std::string::npos) << c.warning;
 }
 
-sim::SimConfig Short() {
-  sim::SimConfig c =
-      sim::ExperimentConfig(sim::Regime::kMedium, 100, sim::kExperimentSeed, sim::WorldKind::kBox);
-  c.duration_s = 3.0;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 4;
-  return c;
-}
-
-// The simulated source with every IMU sample's specific force passed through `mutate`.
-class AccelMutatedSource : public io::DataSource {
- public:
-  AccelMutatedSource(const sim::SimConfig& c, std::function<Vec3(const Vec3&)> mutate)
-      : source_(c, "sim:accel"), mutate_(std::move(mutate)) {}
-  std::string Name() const override { return source_.Name(); }
-  size_t NumScans() const override { return 0; }
-  bool Next(io::ScanFrame* frame) override {
-    if (!source_.Next(frame)) return false;
-    for (ImuSample& s : frame->imu) s.accel = mutate_(s.accel);
+// The simulated sequence with every IMU sample's specific force passed through `mutate`.
+testing::MutatedSource AccelMutatedSource(std::function<Vec3(const Vec3&)> mutate) {
+  return testing::MutatedSource(testing::ShortMediumSequence(), [mutate](io::ScanFrame* frame) {
+    for (ImuSample& s : frame->imu) s.accel = mutate(s.accel);
     return true;
-  }
-  SE3 ImuFromLidar() const override { return source_.ImuFromLidar(); }
-  std::optional<std::vector<io::StampedPose>> GroundTruth() const override {
-    return source_.GroundTruth();
-  }
-  std::optional<double> Gravity() const override { return source_.Gravity(); }
-  std::vector<io::ImuInfo> Imus() const override { return source_.Imus(); }
-
- private:
-  sim::SimulatedSource source_;
-  std::function<Vec3(const Vec3&)> mutate_;
-};
+  });
+}
 
 TEST(ImuConsistency, AFlippedAccelerometerIsWarnedAboutTheCleanRunIsNot) {
   const std::vector<std::pair<std::string, std::function<Vec3(const Vec3&)>>> cases = {
@@ -129,7 +105,7 @@ TEST(ImuConsistency, AFlippedAccelerometerIsWarnedAboutTheCleanRunIsNot) {
     double clean = 0.0;
     for (const auto& [name, mutate] : cases) {
       SCOPED_TRACE(name + " " + LioMethodName(m));
-      AccelMutatedSource source(Short(), mutate);
+      testing::MutatedSource source = AccelMutatedSource(mutate);
       const lioapp::RunSummary run =
           lioapp::RunOdometry(source, testing::SimLioConfig().ForMethod(m));
       std::printf("%s, %s: median accel chi2/dof %.3g, gyro %.3g over %d moving scans; ATE %.4f\n",

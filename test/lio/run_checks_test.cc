@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/mutated_source.h"
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -21,45 +22,8 @@
 namespace ctlio::lio {
 namespace {
 
-sim::SimConfig Short() {
-  sim::SimConfig c =
-      sim::ExperimentConfig(sim::Regime::kMedium, 100, sim::kExperimentSeed, sim::WorldKind::kBox);
-  c.duration_s = 3.0;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 4;
-  return c;
-}
-
-// The simulated source with each frame passed through `mutate` (false: the frame is dropped from
-// the recording; its IMU samples go with the next frame, as a reader would hand them on).
-class MutatedSource : public io::DataSource {
- public:
-  MutatedSource(const sim::SimConfig& c, std::function<bool(io::ScanFrame*)> mutate)
-      : source_(c, "sim:mutated"), mutate_(std::move(mutate)) {}
-  std::string Name() const override { return source_.Name(); }
-  size_t NumScans() const override { return 0; }
-  bool Next(io::ScanFrame* frame) override {
-    std::vector<io::ImuSample> carried;
-    while (source_.Next(frame)) {
-      carried.insert(carried.end(), frame->imu.begin(), frame->imu.end());
-      if (mutate_(frame)) {
-        frame->imu = std::move(carried);
-        return true;
-      }
-    }
-    return false;
-  }
-  SE3 ImuFromLidar() const override { return source_.ImuFromLidar(); }
-  std::optional<std::vector<io::StampedPose>> GroundTruth() const override {
-    return source_.GroundTruth();
-  }
-  std::optional<double> Gravity() const override { return source_.Gravity(); }
-  std::vector<io::ImuInfo> Imus() const override { return source_.Imus(); }
-
- private:
-  sim::SimulatedSource source_;
-  std::function<bool(io::ScanFrame*)> mutate_;
-};
+using testing::MutatedSource;
+using testing::ShortMediumSequence;
 
 TEST(RunChecks, ARunWithEveryScanUnusableIsAFailureWithoutAte) {
   struct Case {
@@ -87,7 +51,7 @@ TEST(RunChecks, ARunWithEveryScanUnusableIsAFailureWithoutAte) {
   for (const Case& c : cases) {
     for (const LioMethod m : {LioMethod::kLidarOnly, LioMethod::kSingerLio}) {
       SCOPED_TRACE(c.name + " " + LioMethodName(m));
-      MutatedSource source(Short(), [&](io::ScanFrame* f) {
+      MutatedSource source(ShortMediumSequence(), [&](io::ScanFrame* f) {
         c.mutate(&f->cloud);
         return true;
       });
@@ -105,7 +69,7 @@ TEST(RunChecks, ARunWithEveryScanUnusableIsAFailureWithoutAte) {
   }
   EXPECT_EQ(tried, 6);
   // The clean run is neither.
-  MutatedSource clean(Short(), [](io::ScanFrame*) { return true; });
+  MutatedSource clean(ShortMediumSequence(), [](io::ScanFrame*) { return true; });
   const lioapp::RunSummary run =
       lioapp::RunOdometry(clean, testing::SimLioConfig().ForMethod(LioMethod::kLidarOnly));
   EXPECT_TRUE(run.unregistered_run.empty()) << run.unregistered_run;
@@ -119,11 +83,11 @@ TEST(RunChecks, ARunWithEveryScanUnusableIsAFailureWithoutAte) {
 TEST(RunChecks, OneSecondOfMissingScansIsReportedAsALidarGap) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kLidarOnly}) {
     SCOPED_TRACE(LioMethodName(m));
-    MutatedSource clean_source(Short(), [](io::ScanFrame*) { return true; });
+    MutatedSource clean_source(ShortMediumSequence(), [](io::ScanFrame*) { return true; });
     const lioapp::RunSummary clean =
         lioapp::RunOdometry(clean_source, testing::SimLioConfig().ForMethod(m));
-    MutatedSource source(Short(), [](io::ScanFrame* f) {
-      const int64_t t0 = Short().start_ns;
+    MutatedSource source(ShortMediumSequence(), [](io::ScanFrame* f) {
+      const int64_t t0 = ShortMediumSequence().start_ns;
       return !(f->end_ns - t0 > 1'000'000'000 && f->end_ns - t0 <= 2'000'000'000);
     });
     const lioapp::RunSummary run =
@@ -171,7 +135,7 @@ TEST(RunChecks, LidarGapsAndUnregisteredRunsByTheirDefinition) {
 // are named by the runner as such; the gravity initialisation they spoil (its window lands in
 // motion) no longer blames only the accelerometer's units.
 TEST(RunChecks, OverlappingScanIntervalsAreReportedAsTheCause) {
-  MutatedSource source(Short(), [](io::ScanFrame* f) {
+  MutatedSource source(ShortMediumSequence(), [](io::ScanFrame* f) {
     f->end_ns += 150'000'000;
     return true;
   });
@@ -188,7 +152,7 @@ TEST(RunChecks, OverlappingScanIntervalsAreReportedAsTheCause) {
             std::string::npos)
       << run.first_failure;
   // The clean sequence has none.
-  MutatedSource clean(Short(), [](io::ScanFrame*) { return true; });
+  MutatedSource clean(ShortMediumSequence(), [](io::ScanFrame*) { return true; });
   EXPECT_EQ(lioapp::RunOdometry(clean, testing::SimLioConfig().ForMethod(LioMethod::kSingerLio))
                 .overlapping_scans,
             0);
