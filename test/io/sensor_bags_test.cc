@@ -204,19 +204,28 @@ TEST(SensorBags, EachRecordingSuggestsItsOwnConfig) {
   const fs::path d = testing::FreshTempDir("sensor_bags_suggest");
   for (const sim::SensorModel& m : sim::SensorModels()) {
     SCOPED_TRACE(m.name);
-    const std::string bag = (d / (m.name + ".bag")).string();
     sim::SimConfig c = SensorSim(m.name, 1'000'000'000LL);
     c.duration_s = 0.2;
-    sim::SimulatedSource written(c);
     RosbagWriteOptions wo;
     wo.UseDriver(m.driver);
-    WriteRosbag(written, bag, wo);
-    const auto s = SuggestSensorConfigForBag(bag, m.driver.lidar_topic);
-    ASSERT_TRUE(s.has_value());
-    EXPECT_EQ(s->sensor, m.name) << s->evidence;
-    EXPECT_EQ(s->config, "data/sensors/" + m.name + ".yaml");
-    EXPECT_TRUE(fs::is_regular_file(fs::path(CTLIO_SOURCE_DIR) / s->config));
-    EXPECT_EQ(s->note.empty(), m.driver.accel_unit == 1.0);  // Livox: the g advice
+    // The same recording as a ROS 1 bag and as a ROS 2 bag folder (MCAP).
+    const std::string ros1 = (d / (m.name + ".bag")).string(), ros2 = (d / m.name).string();
+    {
+      sim::SimulatedSource written(c);
+      WriteRosbag(written, ros1, wo);
+    }
+    {
+      sim::SimulatedSource written(c);
+      WriteRos2Bag(written, ros2, wo);
+    }
+    for (const std::string& bag : {ros1, ros2}) {
+      const auto s = SuggestSensorConfigForBag(bag, m.driver.lidar_topic);
+      ASSERT_TRUE(s.has_value()) << bag;
+      EXPECT_EQ(s->sensor, m.name) << s->evidence;
+      EXPECT_EQ(s->config, "data/sensors/" + m.name + ".yaml");
+      EXPECT_TRUE(fs::is_regular_file(fs::path(CTLIO_SOURCE_DIR) / s->config));
+      EXPECT_EQ(s->note.empty(), m.driver.accel_unit == 1.0);  // Livox: the g advice
+    }
   }
   EXPECT_FALSE(SuggestSensorConfigForBag((d / "absent.bag").string(), "/x").has_value());
 }
