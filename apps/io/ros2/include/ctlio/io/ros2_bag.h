@@ -33,9 +33,9 @@ struct Ros2Topic {
 };
 
 struct Ros2Message {
-  size_t topic = 0;          // index into Ros2BagReader::topics()
-  int64_t log_time_ns = 0;   // the recorder's receive time (MCAP log_time, SQLite timestamp)
-  std::vector<uint8_t> data; // serialized bytes
+  size_t topic = 0;           // index into Ros2BagReader::topics()
+  int64_t log_time_ns = 0;    // the recorder's receive time (MCAP log_time, SQLite timestamp)
+  std::vector<uint8_t> data;  // serialized bytes
 };
 
 // True if `path` is a ROS 2 bag: a folder holding metadata.yaml, or a file starting with the MCAP
