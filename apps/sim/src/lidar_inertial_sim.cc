@@ -298,7 +298,30 @@ void LidarInertialSim::ApplyImuOutages(size_t j) {
 
 io::PointCloud LidarInertialSim::Scan(size_t k) const {
   const auto& L = config_.lidar;
-  if (L.pattern.kind != PatternKind::kSpinning) return PatternScan(k);
+  // The ray directions of firing f, beam b at time t [s]: d_l, where the point is reported (the
+  // lidar's nominal direction), and d_ray, where the ray really goes (differs by the fixed per-beam
+  // angle errors). A spinning lidar's come from its beam table and azimuth; a non-repetitive
+  // (Livox) pattern's from scan_pattern.h, without beam errors.
+  if (L.pattern.kind != PatternKind::kSpinning) {
+    return ScanRays(k, [&](int, int b, double t, Vec3* d_l, Vec3* d_ray) {
+      *d_l = *d_ray = PatternDirection(L.pattern, b, L.beams, t);
+    });
+  }
+  const bool beam_errors = !beam_el_error_.empty();
+  return ScanRays(k, [&](int f, int b, double, Vec3* d_l, Vec3* d_ray) {
+    *d_l = Vec3(cos_el_[b] * cos_az_[f], cos_el_[b] * sin_az_[f], sin_el_[b]);
+    *d_ray = *d_l;
+    if (beam_errors) {
+      const double el = std::asin(sin_el_[b]) + beam_el_error_[b];
+      const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
+      *d_ray = Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    }
+  });
+}
+
+template <class Directions>
+io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions) const {
+  const auto& L = config_.lidar;
   io::PointCloud cloud;
   cloud.stamp_ns = ScanStartNs(k);
   const size_t firings =
@@ -315,32 +338,29 @@ io::PointCloud LidarInertialSim::Scan(size_t k) const {
                          uint32_t(k)};
   std::mt19937_64 lost_rng(lost_seq);
   const double cos_max_incidence = std::cos(L.max_incidence_deg * M_PI / 180.0);
-  const bool beam_errors = !beam_el_error_.empty();
   const bool incidence = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
+  // One pose per firing: all beams (lines) of a firing share its time.
   for (int f = 0; f < L.firings_per_revolution; f += L.firing_decimation) {
     const int64_t t_ns = FiringTimeNs(k, f);
-    const SE3 T_wl = WorldFromLidar(Seconds(t_ns));
+    const double t = Seconds(t_ns);
+    const SE3 T_wl = WorldFromLidar(t);
     const Vec3& o = T_wl.translation();
     const Mat3& C = T_wl.rotation();
     for (int b = 0; b < L.beams; ++b) {
-      const Vec3 d_l(cos_el_[b] * cos_az_[f], cos_el_[b] * sin_az_[f], sin_el_[b]);
+      Vec3 d_l, d_ray;
+      directions(f, b, t, &d_l, &d_ray);
       const double n = normal(rng);  // drawn for every ray: stable streams
       const double noise = L.range_noise * n;
       const bool lost = L.dropout > 0.0 && Uniform(lost_rng, 0, 1) < L.dropout;
-      Vec3 d_ray = d_l;  // the true ray direction
-      if (beam_errors) {
-        const double el = std::asin(sin_el_[b]) + beam_el_error_[b];
-        const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
-        d_ray = Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-      }
-      const RayHit hit = Cast(o, C * d_ray, Seconds(t_ns));
+      const Vec3 d_w = C * d_ray;
+      const RayHit hit = Cast(o, d_w, t);  // t: where the moving people are
       const double r = hit.t;
       if (!std::isfinite(r) || lost) continue;
       const double m =
           L.range_noise_per_m > 0.0 ? r + noise + L.range_noise_per_m * r * n : r + noise;
       if (m < L.min_range || m > L.max_range) continue;
       if (incidence) {
-        const double cos_incidence = std::abs(hit.normal.dot(C * d_ray));
+        const double cos_incidence = std::abs(hit.normal.dot(d_w));
         if (cos_incidence < cos_max_incidence) continue;
         if (L.reflect_range > 0.0 && r > L.reflect_range * std::sqrt(cos_incidence)) continue;
       }

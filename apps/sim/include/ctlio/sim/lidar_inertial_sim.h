@@ -235,8 +235,10 @@ class LidarInertialSim {
   // The nearest surface along a ray (normals only where realism needs them in the box room).
   // `time` [s since the start] places the world's moving people (Scene::movers).
   RayHit Cast(const Vec3& o, const Vec3& d, double time = 0.0) const;
-  // Scan k of a non-repetitive pattern (sensor_scan.cc).
-  io::PointCloud PatternScan(size_t k) const;
+  // Scan k with the ray directions `directions(f, b, t, &d_l, &d_ray)` of firing f, beam b at
+  // time t (Scan: the spinning lidar's beam table or a non-repetitive pattern); one loop for both.
+  template <class Directions>
+  io::PointCloud ScanRays(size_t k, const Directions& directions) const;
   // IMU j's samples, biases and outages (IMU 0 draws from the single-IMU streams).
   void GenerateImu(size_t j);
   void ApplyImuOutages(size_t j);
