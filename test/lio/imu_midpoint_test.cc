@@ -42,13 +42,38 @@ TEST(ImuMidpoint, SegmentsCarryTheLinearSignalAtTheirCentres) {
   EXPECT_DOUBLE_EQ(seg[1].dt, 0.005);  // the segments themselves are unchanged
 }
 
-TEST(ImuMidpoint, NewestStretchWithoutNextSampleKeepsTheHeldValue) {
+// The newest stretch (after the newest sample, before the next has arrived) takes the line
+// through the last two samples at its centre: exact for a ramp. Beyond one sample period after
+// the newest sample (a gap) the sample is held.
+TEST(ImuMidpoint, NewestStretchIsExtrapolatedFromTheLastTwoSamples) {
   const ImuBuffer b = Ramp(2.0, 0.01);  // samples at 0, 5, 10 ms
   std::vector<ImuSegment> seg = b.Segments(0.005, 0.013, nullptr);
   ASSERT_EQ(seg.size(), 2u);
   InterpolateAtMidpoints(b, b.samples(0), &seg);
   EXPECT_NEAR(seg[0].gyro.z(), 2.0 * 0.0075, 1e-12);
-  EXPECT_DOUBLE_EQ(seg[1].gyro.z(), 2.0 * 0.01);  // sample at 10 ms held: nothing after it
+  EXPECT_NEAR(seg[1].gyro.z(), 2.0 * 0.0115, 1e-12);  // centre of [10, 13] ms
+  EXPECT_NEAR(seg[1].accel.x(), 0.0115, 1e-12);
+
+  std::vector<ImuSegment> gap = b.Segments(0.005, 0.02, nullptr);  // ends 10 ms after the newest
+  InterpolateAtMidpoints(b, b.samples(0), &gap);
+  EXPECT_DOUBLE_EQ(gap.back().gyro.z(), 2.0 * 0.01);  // held
+}
+
+// A scan ending between samples, its next sample not yet arrived (as the odometry sees it):
+// constant angular acceleration α, the angle over [0, T] is αT²/2. Held, the newest stretch of
+// length δ = 3 ms loses α·δ²/2 (here 0.09 mrad, 10× the baseline's rotation σ in fast motion); the
+// extrapolation makes it exact.
+TEST(ImuMidpoint, ScanEndingBetweenSamplesIntegratesARampExactly) {
+  const double alpha = 20.0, T = 0.103;
+  const ImuBuffer b = Ramp(alpha, 0.1);  // newest sample at 100 ms
+  std::vector<ImuSegment> seg = b.Segments(0.0, T, nullptr);
+  InterpolateAtMidpoints(b, b.samples(0), &seg);
+  imu::PreintegratedImu pim(Vec6::Zero(), imu::ImuNoise{1e-3, 1e-3, 0.0});
+  for (const ImuSegment& s : seg) pim.Integrate(s.accel, s.gyro, s.dt);
+  EXPECT_NEAR(so3::Log(pim.delta_rotation()).z(), 0.5 * alpha * T * T, 1e-12);
+  // The held value at 100 ms over [100, 103] ms would be short by α·δ²/2 = 9e-5 rad.
+  const double held = 0.5 * alpha * 0.1 * 0.1 + alpha * 0.1 * 0.003;
+  EXPECT_GT(0.5 * alpha * T * T - held, 8.9e-5);
 }
 
 // Constant angular acceleration α about z: the angle over [0, T] is αT²/2. At the midpoints it

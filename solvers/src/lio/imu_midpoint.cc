@@ -8,9 +8,21 @@ void InterpolateAtMidpoints(const ImuBuffer& buffer, const std::deque<ImuSample>
   for (ImuSegment& seg : *segments) {
     const double t_mid = seg.t_begin + 0.5 * seg.dt;
     while (j < samples.size() && buffer.Seconds(samples[j].t_ns) <= t_mid) ++j;
-    if (j == 0 || j == samples.size()) continue;
-    const ImuSample& a = samples[j - 1];
-    const ImuSample& b = samples[j];
+    if (j == 0) continue;
+    size_t i_b = j;
+    if (j == samples.size()) {
+      // The newest stretch: its next sample has not arrived. Held, the stretch of length δ would
+      // be off by ω̇·δ/2 in rate (ω̇·δ²/2 in angle, once per scan: at 200 Hz in fast motion 10×
+      // the rotation σ, falling as Δt²); the line through the last two samples carries it to
+      // O(ω̈·δ·Δt), if the stretch ends within one sample period of the newest sample.
+      if (j < 2) continue;
+      const double t_last = buffer.Seconds(samples[j - 1].t_ns);
+      const double period = t_last - buffer.Seconds(samples[j - 2].t_ns);
+      if (!(period > 0.0) || seg.t_begin + seg.dt > t_last + period + 1e-9) continue;
+      i_b = j - 1;
+    }
+    const ImuSample& a = samples[i_b - 1];
+    const ImuSample& b = samples[i_b];
     const double t_a = buffer.Seconds(a.t_ns);
     const double s = (t_mid - t_a) / (buffer.Seconds(b.t_ns) - t_a);
     seg.gyro = a.gyro + s * (b.gyro - a.gyro);

@@ -8,6 +8,11 @@
 // rule between two samples) is exact for a signal linear between samples. Measured on the
 // simulator (5 s, tuning indices 100-102): rotation NEES 204 -> 6.6 (medium), 480 -> 20-37
 // (fast); a cubic through four samples, alone or at two Gauss points, was worse on fast (39-61).
+// What was left on fast motion came from the newest stretch of each interval, from the last
+// sample to the scan's end: its next sample has not arrived when the scan is processed, and held
+// it lost ω̇·δ²/2 once per scan (δ ≤ Δt, so the error fell as Δt²). It is extrapolated along the
+// last two samples: rotation NEES on tuning indices 100-101 (5 s) 30.2 -> 5.6 fast, 5.7 -> 3.7
+// medium (docs/experiments/covariance.md).
 #pragma once
 
 #include <deque>
@@ -19,8 +24,9 @@ namespace ctlio::lio {
 
 // Replaces each segment's gyro and accel by the stream `samples` (one IMU's, stamps converted to
 // the segments' seconds by `buffer`) interpolated at the segment's midpoint. A segment with no
-// sample after its midpoint (the newest stretch, whose next sample has not arrived) keeps its
-// held value. Segments must be in time order.
+// sample after its midpoint (the newest stretch, whose next sample has not arrived) takes the
+// line through the last two samples at its midpoint if it ends within one sample period of the
+// newest sample, else (a gap) keeps its held value. Segments must be in time order.
 void InterpolateAtMidpoints(const ImuBuffer& buffer, const std::deque<ImuSample>& samples,
                             std::vector<ImuSegment>* segments);
 
