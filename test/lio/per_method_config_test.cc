@@ -110,5 +110,29 @@ TEST(PerMethodConfig, PoseCovarianceLidarScaleIsPerMethodAndPositive) {
   }
 }
 
+// The adaptive covariance's lidar inflation: per method as the data configs set it; below 1
+// (it inflates), absurd or NaN is an error naming the key.
+TEST(PerMethodConfig, PoseCovarianceLidarNeffIsPerMethodAndAtLeastOne) {
+  const OdometryConfig c = LoadOdometryConfig(
+      WriteTemp("neff.yaml",
+                "window: {pose_covariance_adaptive: true, pose_covariance_lidar_neff: 10}\n"
+                "per_method:\n"
+                "  imu_input: {window: {pose_covariance_lidar_neff: 40}}\n"));
+  EXPECT_TRUE(c.pose_covariance_adaptive);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_lidar_neff, 10.0);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_neff, 40.0);
+  for (const char* bad : {"0.5", "-2", "1e9", ".nan"}) {
+    const std::string path = WriteTemp(
+        "neff_bad.yaml", std::string("window:\n  pose_covariance_lidar_neff: ") + bad + "\n");
+    try {
+      LoadOdometryConfig(path);
+      ADD_FAILURE() << "expected an error for " << bad;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("pose_covariance_lidar_neff"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio

@@ -251,17 +251,48 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map += MsSince(t_map);
   estimator_->Report(result);
-  if (config_.pose_covariance) ReportPoseCovariance(registered.lidar_blocks, result);
+  if (config_.pose_covariance) ReportPoseCovariance(registered, lidar.get(), result);
   calibration_.Report(estimator_->NewestKeys(), &window_, result);
 }
 
-void LioOdometry::ReportPoseCovariance(const std::vector<ceres::ResidualBlockId>& lidar,
+void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
                                        ScanResult* result) {
-  // Not rescaled by the lidar term's own χ² (LidarChiSquareScale): on the tuning sequences that
-  // made the baseline 40x overconfident (docs/experiments/covariance.md). A fixed scale of the
-  // lidar variance (pose_covariance_lidar_scale) is a per-method setting instead. A
-  // rank-deficient window gives no covariance (the scan then has none).
+  const std::vector<ceres::ResidualBlockId>& lidar = registered.lidar_blocks;
+  // window.pose_covariance_adaptive: noise levels from this scan's residuals
+  // (adaptive_covariance.h); else the window as solved, or with a fixed lidar variance scale. Not
+  // the lidar term's plain χ² (LidarChiSquareScale): its spread alone made the baseline 40x
+  // overconfident (docs/experiments/covariance.md). A rank-deficient window gives no covariance.
   const StateId pose = estimator_->NewestPoseKey();
+  if (config_.pose_covariance_adaptive) {
+    const ImuTermBlocks& imu = estimator_->NewestImuBlocks();
+    double lidar_estimate = 0.0;  // no lidar term: nothing to scale
+    if (!registered.associated.empty()) {
+      // The residuals at the estimate, in metres (the window's are whitened, and a batched
+      // term's rows are not per keypoint).
+      std::vector<double> e;
+      std::vector<Vec3> at;
+      term->BeginRound();
+      for (size_t i = 0; i < registered.associated.size(); ++i) {
+        if (!registered.associated[i]) continue;
+        const PlaneAssociation& a = registered.planes[i];
+        Vec3 q, p_map;
+        term->Locate(i, &q, &p_map);
+        e.push_back(a.weight * a.plane_normal.dot(p_map - a.plane_point));
+        at.push_back(a.plane_point);
+      }
+      const LidarSpread spread = MeasureLidarSpread(e, at, kLidarPlaneCell);
+      const double sigma = config_.frontend.point_noise_sigma;
+      lidar_estimate =
+          config_.pose_covariance_lidar_neff * spread.effective_variance() / (sigma * sigma);
+    }
+    const std::optional<Mat6> S = covariance_scales_.Compute(
+        &window_, pose, lidar_estimate, lidar, imu.accel, imu.gyro, last_marginalization_.prior,
+        result->T_mr, estimator_->NewestPoseTangentFromBody());
+    if (!S) return;
+    result->pose_covariance = *S;
+    result->has_pose_covariance = true;
+    return;
+  }
   const double scale = config_.pose_covariance_lidar_scale;
   const std::optional<Mat6> S =
       scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,

@@ -145,6 +145,8 @@ void OdometryConfig::Validate() const {
   require(gap_hold_max >= 0, "imu.gap_hold_max must be >= 0");
   require(max_scan_translation > 0, "init.max_scan_translation must be positive");
   require(pose_covariance_lidar_scale > 0, "window.pose_covariance_lidar_scale must be positive");
+  require(pose_covariance_lidar_neff >= 1.0 && pose_covariance_lidar_neff <= 1e6,
+          "window.pose_covariance_lidar_neff must be in [1, 1e6]");
   require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
           "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
@@ -250,7 +252,9 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
            {"imu_prediction", SetFromYaml(&c->imu_prediction)},
            {"pose_covariance", SetFromYaml(&c->pose_covariance)},
-           {"pose_covariance_lidar_scale", SetFromYaml(&c->pose_covariance_lidar_scale)}});
+           {"pose_covariance_lidar_scale", SetFromYaml(&c->pose_covariance_lidar_scale)},
+           {"pose_covariance_adaptive", SetFromYaml(&c->pose_covariance_adaptive)},
+           {"pose_covariance_lidar_neff", SetFromYaml(&c->pose_covariance_lidar_neff)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

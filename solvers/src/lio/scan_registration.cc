@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "ctlio/solvers/lio/frontend.h"
@@ -159,6 +160,10 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
       summary.converged = true;
       break;
     }
+  }
+  if (!summary.degenerate) {
+    summary.planes = std::move(planes);
+    summary.associated = std::move(associated);
   }
   if (batched) {
     summary.lidar_blocks = batch_blocks;

@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "ctlio/solvers/lio/adaptive_covariance.h"
 #include "ctlio/solvers/lio/calibration_states.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/final_trajectory.h"
@@ -123,7 +124,8 @@ class LioOdometry {
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
-  void ReportPoseCovariance(const std::vector<ceres::ResidualBlockId>& lidar, ScanResult* result);
+  void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
+                            ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
@@ -155,6 +157,7 @@ class LioOdometry {
   bool initialised_ = false;
   std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
+  AdaptiveNoiseScales covariance_scales_;  // window.pose_covariance_adaptive
   CalibrationStates calibration_;
   int num_marginalizations_ = 0;
   PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused

@@ -161,6 +161,14 @@ struct OdometryConfig {
   // blocks divided by it (ScaledPoseCovariance). For a lidar σ that weighs the estimate well but
   // overstates the pose's spread (docs/experiments/covariance.md).
   double pose_covariance_lidar_scale = 1.0;
+  // window.pose_covariance_adaptive: the covariance with each noise group's variance estimated
+  // from its own residuals at every scan (adaptive_covariance.h; the estimate is unchanged;
+  // overrides pose_covariance_lidar_scale): the lidar's from the robust spread of its
+  // point-to-plane residuals, inflated by pose_covariance_lidar_neff for the errors its residuals
+  // share (map planes, deskewing) that the pose absorbs and the spread cannot show; the IMU
+  // terms' by variance components; the marginal prior's alike.
+  bool pose_covariance_adaptive = false;
+  double pose_covariance_lidar_neff = 10.0;
 
   // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
   // every one). Bounded so that the pipeline's memory does not grow with the length of the run

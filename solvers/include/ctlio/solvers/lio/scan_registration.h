@@ -84,6 +84,10 @@ struct RegistrationSummary {
   // The last round's residuals (in the window): one per keypoint, in keypoint order, or with a
   // batched term one per knot interval.
   std::vector<ceres::ResidualBlockId> lidar_blocks;
+  // The last round's planes per keypoint (weight not whitened) and whether it has one (empty if
+  // degenerate): what the residuals measure, e.g. for their spread (adaptive_covariance.h).
+  std::vector<PlaneAssociation> planes;
+  std::vector<uint8_t> associated;
 };
 
 // The robust loss of the point-to-plane residuals (cauchy/huber/none, SPEC §4): the residuals
