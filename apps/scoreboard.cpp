@@ -22,8 +22,10 @@
 #include "ctlio/io/checked_output.h"
 
 DEFINE_string(cells, "", "Comma-separated ctlio_experiment output folders, one per cell");
-DEFINE_string(cells_under, "",
-              "A folder whose sub-folders are the cells (sorted by name); instead of --cells");
+DEFINE_string(
+    cells_under, "",
+    "A folder whose sub-folders with a results.csv are the cells (sorted by name); with or "
+    "instead of --cells");
 DEFINE_string(out, "", "Output folder (required)");
 DEFINE_string(note, "", "A line for the table's header (e.g. the command and a reduction)");
 
@@ -45,7 +47,14 @@ int main(int argc, char** argv) {
       }
       std::vector<std::string> found;
       for (const auto& e : std::filesystem::directory_iterator(FLAGS_cells_under)) {
-        if (e.is_directory()) found.push_back(e.path().string());
+        if (!e.is_directory()) continue;
+        // An interrupted cell (scripts/scoreboard.sh's CELL.tmp) has no results.csv yet.
+        if (!std::filesystem::exists(e.path() / "results.csv")) {
+          std::fprintf(stderr, "ctlio_scoreboard: skipped %s (no results.csv: unfinished)\n",
+                       e.path().string().c_str());
+          continue;
+        }
+        found.push_back(e.path().string());
       }
       std::sort(found.begin(), found.end());
       dirs.insert(dirs.end(), found.begin(), found.end());
