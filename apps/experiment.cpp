@@ -137,6 +137,8 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
     << FLAGS_failure_ate << "\n";
   // Only when set, so that single-IMU settings (and merges with earlier jobs) stay as they were.
   if (!FLAGS_imus.empty()) s << "imus " << FLAGS_imus << "\n";
+  // The scoreboard labels a cell by it (apps/lio/scoreboard.h).
+  if (!FLAGS_sim_sensor.empty()) s << "sensor " << FLAGS_sim_sensor << "\n";
   if (!FLAGS_extrinsic_error.empty()) s << "extrinsic_error " << FLAGS_extrinsic_error << "\n";
   if (shared.lidar.rate_hz != 10.0) s << "lidar_rate_hz " << shared.lidar.rate_hz << "\n";
   return s.str();
