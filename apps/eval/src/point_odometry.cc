@@ -26,8 +26,9 @@ std::vector<Vec3> FirstPerVoxel(const std::vector<Vec3>& points, double voxel) {
 
 }  // namespace
 
-PointOdometry::PointOdometry(const SE3& first, const PointOdometryOptions& options)
-    : options_(options), first_(first) {}
+PointOdometry::PointOdometry(const SE3& first, const PointOdometryOptions& options,
+                             const SE3& motion)
+    : options_(options), first_(first), motion_(motion) {}
 
 size_t PointOdometry::MapSize() const {
   size_t n = 0;
@@ -41,8 +42,8 @@ SE3 PointOdometry::Register(const std::vector<Vec3>& points, const std::vector<d
     throw std::invalid_argument("PointOdometry::Register: one time per point and a period > 0");
   }
   const size_t k = poses_.size();
-  const SE3 delta = k >= 2 ? poses_[k - 2].Inverse() * poses_[k - 1] : SE3();
-  const Vec6 xi = k >= 2 ? delta.Log() : Vec6::Zero();
+  const SE3 delta = k >= 2 ? poses_[k - 2].Inverse() * poses_[k - 1] : motion_;
+  const Vec6 xi = delta.Log();
   std::vector<Vec3> deskewed;
   deskewed.reserve(points.size());
   for (size_t i = 0; i < points.size(); ++i) {

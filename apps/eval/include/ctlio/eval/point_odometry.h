@@ -31,8 +31,10 @@ struct PointOdometryOptions {
 
 class PointOdometry {
  public:
-  // The first sweep's pose is `first` (T_world_lidar at its reference time).
-  explicit PointOdometry(const SE3& first = SE3(), const PointOdometryOptions& options = {});
+  // The first sweep's pose is `first` (T_world_lidar at its reference time); `motion` the
+  // relative motion per sweep assumed until two sweeps are registered (a start in motion).
+  explicit PointOdometry(const SE3& first = SE3(), const PointOdometryOptions& options = {},
+                         const SE3& motion = SE3());
 
   // Registers the next sweep (lidar frame; `times` as above, one per point; `period` the sweep
   // period [s]) and returns its pose T_world_lidar. Throws std::invalid_argument when the sizes
@@ -47,7 +49,7 @@ class PointOdometry {
     std::vector<Vec3> points;
   };
   PointOdometryOptions options_;
-  SE3 first_;
+  SE3 first_, motion_;
   std::vector<SE3> poses_;
   std::vector<std::pair<uint64_t, Voxel>> map_;  // in insertion order (deterministic)
   void AddToMap(const std::vector<Vec3>& world_points, const Vec3& sensor);
