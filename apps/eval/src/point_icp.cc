@@ -55,6 +55,7 @@ PointIcpResult RegisterPointToPoint(const std::vector<Vec3>& source,
       }
       result.correspondences = used;
       if (used < 6) break;
+      if (o.damping > 0.0) H.diagonal() *= 1.0 + o.damping;
       const Vec6 delta = -H.ldlt().solve(g);
       T = SE3::Exp(delta) * T;
       if (delta.norm() < o.converged) break;

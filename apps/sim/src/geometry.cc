@@ -328,6 +328,12 @@ void Scene::Build(double cell) {
         cell_top_[size_t(j) * nx_ + i] = std::max(cell_top_[size_t(j) * nx_ + i], r.zhi);
       }
   }
+  // Each cell's refs from the lowest up: a ray's pass through the cell stops at the first ref
+  // starting above its heights there (CastAt).
+  for (size_t c = 0; c + 1 < cell_start_.size(); ++c) {
+    std::stable_sort(refs_.begin() + cell_start_[c], refs_.begin() + cell_start_[c + 1],
+                     [](const Ref& a, const Ref& b) { return a.zlo < b.zlo; });
+  }
 }
 
 RayHit Scene::IntersectRef(const Ref& r, const Vec3& o, const Vec3& d, const Vec3& inv_d,
@@ -399,7 +405,8 @@ RayHit Scene::CastAt(const Vec3& o, const Vec3& d, double t_max, double time) co
                  if (lo > cell_top_[c]) return false;
                  for (uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
                    const Ref& r = refs_[k];
-                   if (r.zlo > hi || r.zhi < lo) continue;
+                   if (r.zlo > hi) break;  // sorted by zlo (Build)
+                   if (r.zhi < lo) continue;
                    keep(IntersectRef(r, o, d, inv_d, best.t, time), r.kind == kGlass);
                  }
                  return best.t <= tb;

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ctlio/sim/normal_draw.h"
 #include "ctlio/sim/random_draw.h"
 
 namespace ctlio::sim {
@@ -27,11 +28,15 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   const auto& I = config_.imu;
   if (L.dropout < 0 || L.dropout > 1 || L.max_incidence_deg <= 0 || L.max_incidence_deg > 90 ||
       L.reflect_range < 0 || L.range_noise_per_m < 0 || L.elevation_error_deg < 0 ||
-      L.azimuth_error_deg < 0 || I.accel_limit < 0 || I.gyro_limit < 0 || I.outage_rate < 0 ||
+      L.azimuth_error_deg < 0 || L.range_offset_sigma < 0 || L.beam_divergence_rad < 0 ||
+      L.mixed_pixel_probability < 0 || L.mixed_pixel_probability > 1 || L.mixed_pixel_min_gap < 0 ||
+      !(L.grazing_dropout_start_deg >= 0) || L.grazing_dropout_start_deg > 90 ||
+      I.accel_limit < 0 || I.gyro_limit < 0 || I.outage_rate < 0 ||
       (I.outage_rate > 0 &&
        !(I.outage_length_min > 0 && I.outage_length_min <= I.outage_length_max))) {
     throw std::runtime_error(
-        "LidarInertialSim: invalid realism option (dropout in [0, 1], incidence in (0, 90] deg, "
+        "LidarInertialSim: invalid realism option (dropout and mixed-pixel probability in "
+        "[0, 1], incidence in (0, 90] deg, grazing-dropout start in [0, 90] deg, "
         "ranges, errors, limits and rates ≥ 0, 0 < outage length min ≤ max)");
   }
   world_ = BuildWorld(config_.world, config_.room);
@@ -66,13 +71,23 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   all_imu_ = num_imus == 1 ? imu_[0] : io::MergeImuStreams(imu_);
 
   // Beam and azimuth tables; fixed beam-angle errors from their own stream.
+  // A unit's errors come from its own seed when given (every sequence of the unit shares them).
+  const uint64_t unit_seed = L.unit_seed != 0 ? L.unit_seed : config_.seed;
   if (L.elevation_error_deg > 0 || L.azimuth_error_deg > 0) {
-    std::seed_seq beam_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xBEA4u};
+    std::seed_seq beam_seq{uint32_t(unit_seed), uint32_t(unit_seed >> 32), 0xBEA4u};
     std::mt19937_64 beam_rng(beam_seq);
     std::normal_distribution<double> beam_normal;
     for (int b = 0; b < L.beams; ++b) {
       beam_el_error_.push_back(L.elevation_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
       beam_az_error_.push_back(L.azimuth_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
+    }
+  }
+  if (L.range_offset_sigma > 0) {
+    std::seed_seq range_seq{uint32_t(unit_seed), uint32_t(unit_seed >> 32), 0x0FF5u};
+    std::mt19937_64 range_rng(range_seq);
+    std::normal_distribution<double> range_normal;
+    for (int b = 0; b < L.beams; ++b) {
+      beam_range_offset_.push_back(L.range_offset_sigma * range_normal(range_rng));
     }
   }
   if (!L.elevations_deg.empty() && L.elevations_deg.size() != size_t(L.beams)) {
@@ -255,10 +270,12 @@ double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
 
 RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d, double time) const {
   const auto& L = config_.lidar;
-  const bool need_normal = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
+  const bool need_normal = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0 ||
+                           L.beam_divergence_rad > 0.0 || L.grazing_dropout_start_deg < 90.0;
   if (config_.world.kind == WorldKind::kBox && !need_normal) return {CastRay(o, d), Vec3::Zero()};
   // Farther than this no noise draw brings a return back inside max_range.
-  const double reach = L.max_range * (1 + 6 * L.range_noise_per_m) + 6 * L.range_noise + 1.0;
+  const double reach = L.max_range * (1 + 6 * L.range_noise_per_m + 35 * L.beam_divergence_rad) +
+                       6 * L.range_noise + 4 * L.range_offset_sigma + 1.0;
   return world_.scene.Cast(o, d, reach, time);
 }
 
@@ -332,13 +349,24 @@ io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions
   cloud.ring.reserve(capacity);
   std::seed_seq seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0x11DA7u, uint32_t(k)};
   std::mt19937_64 rng(seq);
-  std::normal_distribution<double> normal;
+  NormalDraw normal;  // std::normal_distribution's values, faster
   // Lost returns draw from their own stream, so the noise stream is the same with or without.
   std::seed_seq lost_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0x1057u,
                          uint32_t(k)};
   std::mt19937_64 lost_rng(lost_seq);
   const double cos_max_incidence = std::cos(L.max_incidence_deg * M_PI / 180.0);
   const bool incidence = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
+  // The unit effects (sensor_effects.h) draw from a third stream, and only when configured, so
+  // the other two streams and the output without them are unchanged bit for bit.
+  const bool footprint = L.beam_divergence_rad > 0.0, grazing = L.grazing_dropout_start_deg < 90.0;
+  const bool mixing = L.mixed_pixel_probability > 0.0;
+  std::seed_seq effect_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xEFFEu,
+                           uint32_t(k)};
+  std::mt19937_64 effect_rng(effect_seq);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // True range of every beam's ray at the previous kept firing (mixed pixels' neighbours).
+  std::vector<double> previous(mixing ? size_t(L.beams) : 0, kInf);
+  const double grazing_start = L.grazing_dropout_start_deg * M_PI / 180.0;
   // One pose per firing: all beams (lines) of a firing share its time.
   for (int f = 0; f < L.firings_per_revolution; f += L.firing_decimation) {
     const int64_t t_ns = FiringTimeNs(k, f);
@@ -354,10 +382,38 @@ io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions
       const bool lost = L.dropout > 0.0 && Uniform(lost_rng, 0, 1) < L.dropout;
       const Vec3 d_w = C * d_ray;
       const RayHit hit = Cast(o, d_w, t);  // t: where the moving people are
-      const double r = hit.t;
+      double r = hit.t;
+      if (mixing) {
+        // The neighbour along the ring (the previous kept firing of this beam): a jump in true
+        // range between the two is a depth edge the footprint straddles. (Not the beam below: on
+        // the ground far away neighbouring rings are metres apart without any edge.)
+        const double r_other = previous[b];
+        previous[b] = r;
+        if (std::isfinite(r) && std::isfinite(r_other) &&
+            std::abs(r_other - r) > L.mixed_pixel_min_gap &&
+            Uniform(effect_rng, 0, 1) < L.mixed_pixel_probability) {
+          r += Uniform(effect_rng, 0, 1) * (r_other - r);
+        }
+      }
       if (!std::isfinite(r) || lost) continue;
-      const double m =
-          L.range_noise_per_m > 0.0 ? r + noise + L.range_noise_per_m * r * n : r + noise;
+      double m = L.range_noise_per_m > 0.0 ? r + noise + L.range_noise_per_m * r * n : r + noise;
+      if (!beam_range_offset_.empty()) m += beam_range_offset_[b];
+      if (footprint || grazing) {
+        const double cos_i = std::max(std::abs(hit.normal.dot(d_w)), 1e-9);
+        if (footprint) {
+          // Uniform depth spread r·δ·tanθ over the footprint (LidarConfig), σ = spread/√12.
+          const double tan_i =
+              std::min(std::sqrt(std::max(1.0 - cos_i * cos_i, 0.0)) / cos_i, 20.0);
+          m += n * r * L.beam_divergence_rad * tan_i / std::sqrt(12.0);
+        }
+        if (grazing) {
+          const double theta = std::acos(std::min(cos_i, 1.0));
+          if (theta > grazing_start &&
+              Uniform(effect_rng, 0, 1) < (theta - grazing_start) / (0.5 * M_PI - grazing_start)) {
+            continue;
+          }
+        }
+      }
       if (m < L.min_range || m > L.max_range) continue;
       if (incidence) {
         const double cos_incidence = std::abs(hit.normal.dot(d_w));

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "ctlio/io/newer_college.h"
+#include "ctlio/sim/sensor_effects.h"
 #include "ctlio/sim/sensor_models.h"
 
 namespace ctlio::sim {
@@ -115,6 +116,18 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrid
                                " does not apply to sensor " + m.name + " (its " +
                                std::to_string(m.lidar.beams) + " beams are the datasheet's)");
     }
+  }
+  std::string effects = o.sensor_effects.value_or("auto");
+  if (effects == "auto") {
+    effects = preset == Preset::kNone    ? "off"
+              : o.sensor                 ? FindSensorModel(*o.sensor).effects_family
+              : preset == Preset::kKitti ? "hdl64"
+                                         : "ouster";
+  }
+  if (effects != "off") {
+    // One unit per experiment seed (never 0: 0 means "the noise seed" to the simulator).
+    const uint64_t unit = (seed ^ 0x5E450C7EF1A3B2D9ULL) | 1ULL;
+    ApplySensorEffects(SensorEffectsOf(effects), unit, &c.lidar);
   }
   if (o.duration_s) c.duration_s = *o.duration_s;
   if (o.beams) c.lidar.beams = *o.beams;

@@ -42,6 +42,7 @@ SensorModel Ouster(const std::string& name, const std::string& description, int 
   m.gyro_bias_walk = 1e-4;
   m.imu_from_lidar = io::NewerCollegeImuFromLidar();
   m.driver = io::DriverConventionOf(io::PointFormat::kOuster);
+  m.effects_family = "ouster";
   return m;
 }
 
@@ -65,6 +66,7 @@ void LivoxImu(SensorModel* m, const Vec3& lidar_in_imu) {
   m->gyro_bias_walk = 1e-4;
   m->imu_from_lidar = SE3(Mat3::Identity(), lidar_in_imu);
   m->driver = io::DriverConventionOf(io::PointFormat::kLivoxCustomMsg);
+  m->effects_family = "livox";
 }
 
 std::vector<SensorModel> BuildModels() {
@@ -96,6 +98,7 @@ std::vector<SensorModel> BuildModels() {
     L.max_range = 100.0;
     ExternalImu(&m, 200.0, 0.10);
     m.driver = io::DriverConventionOf(io::PointFormat::kVelodyne);
+    m.effects_family = "velodyne";
     models.push_back(m);
   }
   {
@@ -118,6 +121,7 @@ std::vector<SensorModel> BuildModels() {
     L.max_range = 100.0;
     ExternalImu(&m, 400.0, 0.15);
     m.driver = io::DriverConventionOf(io::PointFormat::kVelodyne);
+    m.effects_family = "velodyne";
     models.push_back(m);
   }
   {
@@ -138,6 +142,7 @@ std::vector<SensorModel> BuildModels() {
     L.max_range = 120.0;
     ExternalImu(&m, 200.0, 0.10);
     m.driver = io::DriverConventionOf(io::PointFormat::kHesai);
+    m.effects_family = "hesai";
     models.push_back(m);
   }
   {

@@ -20,6 +20,9 @@ struct PointIcpOptions {
   int iterations = 40;                          // per stage, at most
   double kernel = 0.1;      // κ of the Geman–McClure weight, as a fraction of the stage's gate²
   double converged = 1e-5;  // |δ| below which a stage ends
+  // Levenberg damping: (H + μ·diag(H))·δ = −g; 0 = Gauss–Newton. Keeps a step along a direction
+  // the correspondences hardly constrain (a road between walls, a lawn) from running off.
+  double damping = 0.0;
 };
 
 struct PointIcpResult {

@@ -21,7 +21,8 @@
 // d/dt[v; ω] = Ad(P⁻¹)ξ̇_G − ξ_P^⋏·Ad(P⁻¹)ξ_G + ξ̇_P.
 //
 // Sensor realism (all off by default): range-dependent noise, lost returns (random dropout,
-// grazing incidence, weak echoes), fixed per-beam angle errors; IMU scale-factor errors,
+// grazing incidence, weak echoes), fixed per-beam angle and range errors of a unit, footprint
+// spread at oblique incidence, mixed pixels at depth edges; IMU scale-factor errors,
 // saturation and outages (samples absent). See LidarConfig and ImuConfig.
 //
 // Determinism: everything derives from SimConfig::seed through std::seed_seq; a scan is a pure
@@ -98,6 +99,23 @@ struct LidarConfig {
   // reported along the nominal ones (an uncalibrated sensor).
   double elevation_error_deg = 0.0;
   double azimuth_error_deg = 0.0;
+  // Effects of a real sensor unit (sensor_effects.h; defaults off). `unit_seed` draws the fixed
+  // per-unit errors (the beam-angle errors above and the range offsets below) so that every
+  // sequence recorded with one unit shares them; 0: from SimConfig::seed, as before.
+  uint64_t unit_seed = 0;
+  double range_offset_sigma = 0.0;  // σ of a fixed per-beam range offset [m] (calibration)
+  // Footprint spread: a beam of divergence δ lights a spot r·δ wide; on a surface at incidence θ
+  // its depths span r·δ·tanθ, a uniform spread of σ = r·δ·tanθ/√12 added to σ(r) (tanθ ≤ 20).
+  double beam_divergence_rad = 0.0;
+  // Mixed pixels: where the true range jumps by more than `mixed_pixel_min_gap` [m] between this
+  // ray and its neighbour along the ring (the previous kept firing of the beam), the footprint
+  // straddles both surfaces and, with this probability, the return lies between them:
+  // r + u·(r_neighbour − r), u ~ U(0, 1).
+  double mixed_pixel_probability = 0.0;
+  double mixed_pixel_min_gap = 0.5;
+  // Grazing dropouts: a return is lost with probability (θ − start)/(90° − start) for incidence
+  // θ > start [deg] (weak, spread-out echoes); 90 = off.
+  double grazing_dropout_start_deg = 90.0;
   // A datasheet's per-beam elevations [deg], one per beam in ring order; empty: `beams` evenly
   // spaced over [min, max]_elevation_deg (sensor_models.h).
   std::vector<double> elevations_deg;
@@ -222,6 +240,7 @@ class LidarInertialSim {
   double path_start_ = 0.0;                            // arc length where the guided motion starts
   std::vector<std::vector<ImuOutage>> outages_;        // per IMU
   std::vector<double> beam_el_error_, beam_az_error_;  // radians, per beam
+  std::vector<double> beam_range_offset_;              // metres, per beam (unit effects)
   std::vector<SE3> grid_;                              // T_wb at multiples of integration_step_s
   std::vector<std::vector<io::ImuSample>> imu_;        // per IMU
   std::vector<std::vector<Vec6>> biases_;              // per IMU

@@ -52,6 +52,10 @@ struct SimOverrides {
   // A sensor model (sensor_models.h) replacing the preset's lidar, IMU and extrinsic; the other
   // overrides apply on top of it (`beams` only to a sensor without a datasheet beam table).
   std::optional<std::string> sensor;
+  // The unit's sensor effects (sensor_effects.h): "off", or a family (ouster, hdl64, ...); unset:
+  // the preset's (newer_college: ouster, kitti: hdl64, or the --sensor model's family), none
+  // without a preset.
+  std::optional<std::string> sensor_effects;
 };
 
 // The preset's regime, world and duration (kNone: fast, box, 20 s: the Table II simulator).
@@ -61,6 +65,7 @@ double PresetDuration(Preset preset);
 
 // Sequence `index` of the preset: ExperimentConfig(regime, index, seed, world) with the preset's
 // sensors, IMU, extrinsic and duration, then the sensor model and every other given override.
+// The sensor effects' unit is drawn from `seed` alone: every index shares one unit.
 SimConfig PresetConfig(Preset preset, int index, uint64_t seed = kExperimentSeed,
                        const SimOverrides& overrides = {});
 

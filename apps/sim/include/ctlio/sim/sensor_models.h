@@ -36,6 +36,8 @@ struct SensorModel {
   double accel_bias_walk = 0.0, gyro_bias_walk = 0.0;  // per √s
   SE3 imu_from_lidar;                                  // T_imu_lidar of the usual mounting
   io::DriverConvention driver;                         // what its ROS driver writes
+  // Its unit effects (sensor_effects.h), applied by the presets, not by ApplySensorModel.
+  std::string effects_family;
 };
 
 // Every model, in the order `--sensor list` prints them: os0_128, os1_64, os1_128, vlp16,
