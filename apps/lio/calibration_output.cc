@@ -43,6 +43,32 @@ const lio::ScanResult* LastCalibration(const RunSummary& run) {
   return nullptr;
 }
 
+// Per coordinate (calibration order; the extrinsic as calibration.csv's left tangent at the
+// start): how far the estimate moved from the middle scan of those with a free estimate to the
+// last. Scans where a hold prior kept any coordinate (the held pass of the warm-up replay,
+// hold_unobservable) do not count: there the value is the hold's, not an estimate.
+static std::vector<double> SecondHalfMovement(const RunSummary& run) {
+  std::vector<std::vector<double>> x;
+  for (const lio::ScanResult& r : run.scans) {
+    const auto& c = r.calibration;
+    if (c.time_offset_s.empty() && !c.has_extrinsic) continue;
+    if (std::find(c.held.begin(), c.held.end(), true) != c.held.end()) continue;
+    std::vector<double> v = c.time_offset_s;
+    if (c.has_extrinsic) {
+      const Vec6 moved = (c.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
+      v.insert(v.end(), moved.data(), moved.data() + 6);
+    }
+    x.push_back(std::move(v));
+  }
+  if (x.empty()) return {};
+  const std::vector<double>& mid = x[x.size() / 2];
+  const std::vector<double>& last = x.back();
+  if (mid.size() != last.size()) return {};
+  std::vector<double> movement(last.size());
+  for (size_t i = 0; i < last.size(); ++i) movement[i] = std::abs(last[i] - mid[i]);
+  return movement;
+}
+
 std::vector<std::string> CalibrationCoordinates(const lio::ScanResult::CalibrationEstimate& c) {
   std::vector<std::string> names;
   for (size_t j = 0; j < c.time_offset_s.size(); ++j) {
@@ -118,6 +144,7 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
   const Vec6 moved = (r.T_imu_lidar * run.initial_extrinsic.Inverse()).Log();
   r.extrinsic_from_start = moved;
   const std::vector<double> fraction = UnobservableFraction(run);
+  const std::vector<double> movement = SecondHalfMovement(run);
   const std::vector<std::string> names = CalibrationCoordinates(c);
   const size_t imus = r.time_offset_s.size();
   const std::vector<double> prior = options.PriorSigmas(static_cast<int>(imus), c.has_extrinsic);
@@ -137,12 +164,20 @@ std::optional<RecommendedCalibration> RecommendCalibration(const RunSummary& run
     const bool assessed = k.unobservable_fraction >= 0.0;
     const bool contradicted =
         assessed && k.unobservable_fraction > options.write_max_unobservable_fraction;
+    if (i < movement.size() && has_sigma) k.drift_sigmas = movement[i] / sigma;
+    const bool drifting =
+        options.write_max_drift_sigmas > 0.0 && k.drift_sigmas > options.write_max_drift_sigmas;
     std::ostringstream why;
     if (!keep_uninformed_at_start) {
       k.estimate_written = true;
       why << "the estimate, as asked (--calibration_keep_unobservable=false)";
     } else if (!has_sigma) {
       why << "the start: the run reported no sigma for it (a failed covariance)";
+    } else if (drifting) {
+      why << "the start: the estimate moved " << std::setprecision(2) << k.drift_sigmas
+          << " sigma over the second half of the run (more than "
+             "calibration.write_max_drift_sigmas "
+          << options.write_max_drift_sigmas << "): a drift its sigma does not show";
     } else if (sigma < threshold) {
       k.estimate_written = true;
       why << "the estimate: sigma below the threshold, " << Threshold(k.name, threshold);
@@ -310,7 +345,9 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
     << "# why. The estimate is written where its sigma is below the threshold of its kind\n"
     << "# (calibration.write_max_sigma_s, _deg, _m), or where the data informed it: sigma at most\n"
     << "# write_max_sigma_ratio of the prior's and flagged unobservable after at most\n"
-    << "# write_max_unobservable_fraction of the scans. Else the start is kept.\n";
+    << "# write_max_unobservable_fraction of the scans. Else the start is kept, and also where\n"
+    << "# the estimate moved by more than write_max_drift_sigmas sigma over the second half of\n"
+    << "# the run (a drift its sigma does not show).\n";
   if (c.has_extrinsic) {
     f << "# The extrinsic's coordinates are [rho; phi] of T_imu_lidar = Exp([rho; phi]) * T_start\n"
       << "# (calibration.csv's), so its start is 0.\n";
@@ -339,6 +376,10 @@ bool WriteCalibrationYaml(const std::string& path, const RunSummary& run,
     if (k.unobservable_fraction >= 0.0) {
       f << "#   flagged      unobservable after " << std::lround(100.0 * k.unobservable_fraction)
         << "% of the scans (the observability check)\n";
+    }
+    if (std::isfinite(k.drift_sigmas)) {
+      f << "#   moved        " << std::setprecision(2) << k.drift_sigmas << std::setprecision(6)
+        << " sigma over the second half of the run\n";
     }
     f << "#   written      " << u.scale * k.written << "\n"
       << "#   why          " << k.reason << "\n";

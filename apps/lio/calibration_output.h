@@ -4,6 +4,7 @@
 // `imus:`) snippet to paste into an odometry config. Shared by ctlio_odometry and ctlio_experiment.
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -54,9 +55,14 @@ struct CoordinateChoice {
   double written = 0.0;                 // estimate or start
   std::string reason;                   // why that one, for a person
   double unobservable_fraction = -1.0;  // of the assessed scans (< 0: not assessed); information
+  // |last − middle| estimate over the second half of the run's scans, in units of σ (NaN: none).
+  double drift_sigmas = NAN;
 };
 
 // The calibration a run recommends using in a config, per coordinate (CalibrationOptions):
+//  0. the start where the estimate moved by more than write_max_drift_sigmas × σ over the
+//     second half of the run (a drift its σ does not show: the slow regime's δ, 11 ms off with
+//     σ 0.44 ms, docs/experiments/calibration.md);
 //  1. the last estimate where its marginal σ is below the threshold of its kind
 //     (options.write_max_sigma_s, _deg, _m), whatever share of scans the observability check
 //     flagged (issue 45: an offset estimated 20.045 ± 0.20 ms, flagged on 81% of the scans, is

@@ -6,6 +6,7 @@
 // test/lidar/point_to_plane_world_calibrated_test.cc.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -73,6 +74,42 @@ TEST(BaselineCalibration, EstimatesTheClockOffsetAndTheExtrinsicFromTheWrongStar
   const std::vector<ScanResult> off = RunSequence(c, Baseline(false));
   EXPECT_TRUE(off.back().calibration.time_offset_s.empty());
   EXPECT_FALSE(off.back().calibration.has_extrinsic);
+}
+
+// The scan's calibrated residuals as one block (PointToPlaneWorldCalibratedBatch; "interval" its
+// point rows, "square_root" its W + 1 rows) against one block per keypoint ("point"): the same
+// cost, gradient and Gauss–Newton Hessian up to rounding (test/lidar/
+// point_to_plane_world_calibrated_batch_test.cc), so the same estimates up to rounding amplified
+// by the solves (3 s, medium, from the wrong start).
+TEST(BaselineCalibration, BatchedResidualsGiveThePerKeypointEstimates) {
+  const sim::SimConfig c =
+      testing::WrongCalibrationSequence(sim::Regime::kMedium, 3.0, /*imu_stamp_offset_s=*/0.020);
+  OdometryConfig per_point = Baseline(true);
+  per_point.frontend.residual_blocks = "point";
+  const std::vector<ScanResult> a = RunSequence(c, per_point);
+  for (const std::string blocks : {"interval", "square_root"}) {
+    SCOPED_TRACE(blocks);
+    OdometryConfig batched = Baseline(true);
+    batched.frontend.residual_blocks = blocks;
+    const std::vector<ScanResult> b = RunSequence(c, batched);
+    ASSERT_EQ(a.size(), b.size());
+    double worst_m = 0.0, worst_rad = 0.0;
+    for (size_t i = 0; i < a.size(); ++i) {
+      const Vec6 d = (a[i].T_mr * b[i].T_mr.Inverse()).Log();
+      worst_m = std::max(worst_m, d.head<3>().norm());
+      worst_rad = std::max(worst_rad, d.tail<3>().norm());
+    }
+    const ScanResult::CalibrationEstimate& ca = a.back().calibration;
+    const ScanResult::CalibrationEstimate& cb = b.back().calibration;
+    const Vec6 dx = (ca.T_imu_lidar * cb.T_imu_lidar.Inverse()).Log();
+    // Measured: poses <= 3e-7 m / 5e-7 rad apart, delta <= 1e-9 s, extrinsic <= 3.4e-7 m and
+    // 1.1e-8 rad.
+    EXPECT_LT(worst_m, 1e-4);
+    EXPECT_LT(worst_rad, 1e-5);
+    EXPECT_LT(std::abs(ca.time_offset_s[0] - cb.time_offset_s[0]), 1e-6);
+    EXPECT_LT(dx.head<3>().norm(), 1e-4);
+    EXPECT_LT(dx.tail<3>().norm(), 1e-5);
+  }
 }
 
 TEST(BaselineCalibration, EstimatesOneImusClockOffsetOnly) {

@@ -194,6 +194,54 @@ TEST(CalibrationOutput, AnEstimateWithLargeSigmaKeepsTheStart) {
   EXPECT_FALSE(RecommendCalibration(RunSummary(), lio::CalibrationOptions()).has_value());
 }
 
+// An estimate moving over the second half of the run by more than write_max_drift_sigmas (2.5)
+// times its σ keeps the start whatever its σ (slow/101's δ: 11 ms off, σ 0.44 ms, flagged after
+// 2%); a converging one that moved ~σ is written. δ here: σ 0.2 ms (below 0.5 ms), never
+// flagged, moving linearly from scan 50 to the last (100) by 1.0 ms (5σ) or 0.3 ms (1.5σ);
+// φ_x likewise by 0.2° (σ 0.05°: 4σ).
+TEST(CalibrationOutput, AnEstimateThatDriftsOverTheSecondHalfKeepsTheStart) {
+  Vec6 sigma;
+  sigma << 0.005, 0.005, 0.005, 0.05 * kDeg, 0.05 * kDeg, 0.05 * kDeg;
+  const auto drifting = [&](double delta_move, double phi_move) {
+    RunSummary run =
+        ConstructedRun(101, {0, 0, 0, 0, 0, 0, 0}, 0.002, Start(), Estimate(), 2e-4, sigma);
+    for (int k = 50; k <= 100; ++k) {
+      const double s = (k - 50) / 50.0;
+      auto& c = run.scans[static_cast<size_t>(k)].calibration;
+      c.time_offset_s[0] += s * delta_move;
+      Vec6 step = Vec6::Zero();
+      step[3] = s * phi_move;
+      c.T_imu_lidar = SE3::Exp(step) * c.T_imu_lidar;
+    }
+    return run;
+  };
+  const RunSummary run = drifting(1e-3, 0.2 * kDeg);
+  const auto r = RecommendCalibration(run, lio::CalibrationOptions());
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->kept_at_start, (std::vector<std::string>{"time_offset_0", "extrinsic_phi_x"}));
+  EXPECT_EQ(r->time_offset_s[0], 0.002);
+  EXPECT_NEAR(r->coordinates[0].drift_sigmas, 5.0, 1e-6);
+  // φ_x and ρ_x are tangent coordinates of Exp(step)·estimate: nearly, not exactly, additive.
+  EXPECT_NEAR(r->coordinates[4].drift_sigmas, 4.0, 0.1);
+  EXPECT_LT(r->coordinates[1].drift_sigmas, 0.01);
+  EXPECT_NE(r->coordinates[0].reason.find("moved 5 sigma over the second half"), std::string::npos)
+      << r->coordinates[0].reason;
+  // The yaml shows the movement per coordinate.
+  EXPECT_NE(WrittenYaml(run, *r).second.find("#   moved        5 sigma over the second half"),
+            std::string::npos);
+  // 1.5σ: written; the check off (0) or looser (6σ): written too.
+  const auto converging =
+      RecommendCalibration(drifting(3e-4, 0.05 * kDeg), lio::CalibrationOptions());
+  ASSERT_TRUE(converging.has_value());
+  EXPECT_TRUE(converging->kept_at_start.empty());
+  EXPECT_NEAR(converging->time_offset_s[0], 0.0123 + 3e-4, 1e-15);
+  for (const double k : {0.0, 6.0}) {
+    lio::CalibrationOptions o;
+    o.write_max_drift_sigmas = k;
+    EXPECT_TRUE(RecommendCalibration(run, o)->kept_at_start.empty()) << k;
+  }
+}
+
 TEST(CalibrationOutput, NoSigmaKeepsTheStart) {
   // A scan without a covariance reports σ 0 (the extrinsic) or NaN: not a certain estimate.
   const RunSummary run =

@@ -545,6 +545,16 @@ TEST(OdometryConfigComposition, WriteThresholdKeys) {
         LoadError(WriteTemp("write_ratio_bad.yaml", "calibration:\n  " + key + ": 1.5\n"));
     EXPECT_NE(m.find("calibration." + key + " must be in"), std::string::npos) << m;
   }
+  // The drift check's key: read, default 2.5, negative an error naming the key.
+  EXPECT_DOUBLE_EQ(LoadOdometryConfig(
+                       WriteTemp("write_drift.yaml", "calibration:\n  write_max_drift_sigmas: 4\n"))
+                       .calibration.write_max_drift_sigmas,
+                   4.0);
+  EXPECT_DOUBLE_EQ(OdometryConfig().calibration.write_max_drift_sigmas, 2.5);
+  const std::string m =
+      LoadError(WriteTemp("write_drift_bad.yaml", "calibration:\n  write_max_drift_sigmas: -1\n"));
+  EXPECT_NE(m.find("calibration.write_max_drift_sigmas must be finite and >= 0"), std::string::npos)
+      << m;
 }
 
 // The translation of `extrinsic:` wins over xyz_rpy's whatever the key order, so a written

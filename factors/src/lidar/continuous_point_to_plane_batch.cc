@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <vector>
 
+#include "ctlio/factors/lidar/batch_square_root.h"
+
 namespace ctlio {
-namespace {
 
 // R and r₀ of the square-root form (header): RᵀR = H and Rᵀr₀ = g on H's informative subspace,
 // from the lower triangle of H (overwritten). With s = diag(H)^(-1/2) (0 on a zero diagonal),
@@ -15,8 +16,8 @@ namespace {
 // R(k, p_a) = L(a, k)/s(p_a) and L·r₀ = (s∘g)[p] on the kept rows. (Eigen's LDLT pivots on the
 // original diagonal, all ones here, and divides by rounding-level pivots of a semidefinite S.)
 // Returns false on a non-finite H or g.
-bool SquareRootOf(Eigen::MatrixXd* H, const Eigen::VectorXd& g, double threshold,
-                  Eigen::MatrixXd* R, Eigen::VectorXd* r0) {
+bool BatchSquareRoot(Eigen::MatrixXd* H, const Eigen::VectorXd& g, double threshold,
+                     Eigen::MatrixXd* R, Eigen::VectorXd* r0) {
   const Eigen::Index w = H->rows();
   if (!H->allFinite() || !g.allFinite()) return false;
   Eigen::VectorXd s(w), inverse_s(w);
@@ -69,8 +70,6 @@ bool SquareRootOf(Eigen::MatrixXd* H, const Eigen::VectorXd& g, double threshold
   }
   return true;
 }
-
-}  // namespace
 
 bool ContinuousPointToPlaneBatch::EvaluateSquareRoot(double const* const* parameters,
                                                      double* residuals, double** jacobians) const {
@@ -158,7 +157,7 @@ bool ContinuousPointToPlaneBatch::EvaluateSquareRoot(double const* const* parame
   }
   Eigen::MatrixXd R;
   Eigen::VectorXd r0;
-  if (!SquareRootOf(&H, g, kPivotThreshold, &R, &r0)) return false;
+  if (!BatchSquareRoot(&H, g, kPivotThreshold, &R, &r0)) return false;
   std::copy_n(r0.data(), w, residuals);
   residuals[w] = std::sqrt(std::max(cost - r0.squaredNorm(), 0.0));  // clamps rounding only
   for (int b = 0; b < blocks_; ++b) {

@@ -52,6 +52,8 @@ void CalibrationOptions::Validate() const {
   require(std::isfinite(write_max_unobservable_fraction) && write_max_unobservable_fraction >= 0 &&
               write_max_unobservable_fraction <= 1,
           "calibration.write_max_unobservable_fraction must be in [0, 1]");
+  require(std::isfinite(write_max_drift_sigmas) && write_max_drift_sigmas >= 0,
+          "calibration.write_max_drift_sigmas must be finite and >= 0 (0: no drift check)");
   require(!(warmup_replay_hold && warmup_replay_freeze),
           "calibration.warmup_replay_hold and warmup_replay_freeze: choose one for the last pass");
 }

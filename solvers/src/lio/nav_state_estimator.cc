@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ctlio/factors/gp/vector_prior.h"
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
 #include "ctlio/factors/lidar/point_to_plane_world.h"
 #include "ctlio/factors/lidar/point_to_plane_world_calibrated.h"
+#include "ctlio/factors/lidar/point_to_plane_world_calibrated_batch.h"
 #include "ctlio/manifolds/pose_manifold.h"
 #include "ctlio/solvers/lio/bias_priors.h"
 #include "ctlio/solvers/lio/calibration_blocks.h"
@@ -38,7 +42,11 @@ imu::NavState ReadNavState(const NavStateEstimator::State& s) {
 // The keypoints deskewed into the body frame at the scan end by the IMU integrated from the
 // previous state's current estimate (re-integrated every round), at the single pose T_wb. With
 // online calibration each keypoint enters from the lidar frame through T_rl, and the state is
-// carried ε = δ̄ − δ along the body twist to the scan end (PointToPlaneWorldCalibrated).
+// carried ε = δ̄ − δ along the body twist to the scan end (PointToPlaneWorldCalibrated), the
+// scan's keypoints batched into one block unless lidar_frontend.residual_blocks is "point"
+// (PointToPlaneWorldCalibratedBatch: ~600 per-keypoint blocks with the calibration states were
+// 93 ms per scan on medium/0, docs/experiments/calibration.md). Without calibration the
+// per-keypoint blocks stay (the baseline's results as before).
 class DeskewedLidarTerm final : public LidarTerm {
  public:
   DeskewedLidarTerm(const NavStateEstimator& estimator, const NavStateEstimator::State& prev,
@@ -47,7 +55,9 @@ class DeskewedLidarTerm final : public LidarTerm {
         prev_(prev),
         s_(s),
         keypoints_(scan.keypoints),
-        calibrated_(estimator.config().calibration.any()) {
+        calibrated_(estimator.config().calibration.any()),
+        batched_(calibrated_ && estimator.config().frontend.residual_blocks != "point"),
+        square_root_(estimator.config().frontend.residual_blocks == "square_root") {
     if (!calibrated_) return;
     // The lidar-frame points (prepared with the extrinsic estimate of the scan's start).
     const SE3 T_lidar_robot = scan.T_robot_lidar.Inverse();
@@ -101,6 +111,35 @@ class DeskewedLidarTerm final : public LidarTerm {
   }
   SE3 NewestPose() const override { return PoseManifold::Pose(s_.pose); }
 
+  bool batched() const override { return batched_; }
+  void SetBatchResiduals(const std::vector<uint8_t>& associated,
+                         const std::vector<PlaneAssociation>& planes,
+                         const std::shared_ptr<const ceres::LossFunction>& loss,
+                         SlidingWindow* window,
+                         std::vector<ceres::ResidualBlockId>* blocks) override {
+    for (ceres::ResidualBlockId id : *blocks) window->RemoveResidualBlock(id);
+    blocks->clear();
+    std::vector<PointToPlaneWorldCalibratedBatch::Point> points;
+    for (size_t i = 0; i < keypoints_.size(); ++i) {
+      if (associated[i]) points.push_back({planes[i], q_l_[i], deskew_[i]});
+    }
+    if (points.empty()) return;
+    const bool extrinsic = estimator_.estimates_extrinsic();
+    const bool offset = estimator_.estimates_time_offset();
+    using Form = PointToPlaneWorldCalibratedBatch::Form;
+    // W + 1 ≤ 14 rows: the square-root form only for more points than that.
+    const int w = 6 + (extrinsic ? 6 : 0) + (offset ? 1 : 0);
+    const Form form = square_root_ && static_cast<int>(points.size()) > w + 1 ? Form::kSquareRoot
+                                                                              : Form::kPointRows;
+    auto* batch = new PointToPlaneWorldCalibratedBatch(std::move(points), geometry_.twist,
+                                                       geometry_.offset_anchor, loss, extrinsic,
+                                                       offset, T_rl_, form);
+    std::vector<StateId> states = {s_.keys.pose};
+    if (extrinsic) states.push_back(kExtrinsicKey);
+    if (offset) states.push_back(TimeOffsetKey(estimator_.config().input_imu));
+    blocks->push_back(window->AddResidualBlock(batch, nullptr, states));
+  }
+
  private:
   PointToPlaneWorldCalibrated::Geometry Geometry(size_t i) const {
     PointToPlaneWorldCalibrated::Geometry g = geometry_;
@@ -116,7 +155,7 @@ class DeskewedLidarTerm final : public LidarTerm {
   // Per keypoint: its residual's cost function (owned by the window), for UpdateResidual.
   std::vector<PointToPlaneWorld*> costs_;
   // Online calibration: the lidar-frame points, this round's T_rl, twist and per-point deskew.
-  const bool calibrated_;
+  const bool calibrated_, batched_, square_root_;
   std::vector<Vec3> q_l_;
   std::vector<SE3> deskew_;
   SE3 T_rl_;

@@ -304,7 +304,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"write_max_sigma_m",
             SetPositive(&o.write_max_sigma_m, source, section + ".write_max_sigma_m")},
            {"write_max_sigma_ratio", SetFromYaml(&o.write_max_sigma_ratio)},
-           {"write_max_unobservable_fraction", SetFromYaml(&o.write_max_unobservable_fraction)}});
+           {"write_max_unobservable_fraction", SetFromYaml(&o.write_max_unobservable_fraction)},
+           {"write_max_drift_sigmas", SetFromYaml(&o.write_max_drift_sigmas)}});
     } else if (key == "lidar_frontend") {
       c->frontend = LidarFrontendOptionsFromYaml(v, source, c->frontend);
     } else if (key == "input") {

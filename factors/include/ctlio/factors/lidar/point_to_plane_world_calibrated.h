@@ -56,29 +56,45 @@ class PointToPlaneWorldCalibrated final : public ceres::CostFunction {
     const SE3 T_rl = extrinsic_ ? PoseManifold::Pose(parameters[1]) : fixed_T_rl_;
     const double* delta = offset_ ? parameters[extrinsic_ ? 2 : 1] : nullptr;
     const double epsilon = delta != nullptr ? g_.offset_anchor - delta[0] : 0.0;
-    const Vec3 x = T_rl * q_l_;
-    const Vec3 y = g_.deskew * x;
     const SE3 E = SE3::Exp(epsilon * g_.twist);
-    const Vec3 p = T_wb * (E * y);
-    residuals[0] = m_.weight * m_.plane_normal.dot(m_.plane_point - p);
-    if (jacobians == nullptr) return true;
-    const Eigen::Matrix<double, 1, 3> a = -m_.weight * m_.plane_normal.transpose();  // de/dp
-    if (jacobians[0] != nullptr) {
-      LiftPoseJacobian<1>(a * se3::PointJacobian(p), parameters[0], jacobians[0]);
-    }
-    const Eigen::Matrix<double, 1, 3> a_body = a * T_wb.rotation() * E.rotation();  // de/dy
+    const bool want = jacobians != nullptr;
+    Row6 J_wb, J_rl;
+    double J_delta = 0.0;
+    residuals[0] = EvaluateTangent(m_, q_l_, g_.deskew, g_.twist, T_wb, T_rl, E,
+                                   want && jacobians[0] != nullptr ? &J_wb : nullptr,
+                                   want && extrinsic_ && jacobians[1] != nullptr ? &J_rl : nullptr,
+                                   want && offset_ ? &J_delta : nullptr);
+    if (!want) return true;
+    if (jacobians[0] != nullptr) LiftPoseJacobian<1>(J_wb, parameters[0], jacobians[0]);
     if (extrinsic_ && jacobians[1] != nullptr) {
-      const Eigen::Matrix<double, 1, 6> J = a_body * g_.deskew.rotation() * se3::PointJacobian(x);
-      LiftPoseJacobian<1>(J, parameters[1], jacobians[1]);
+      LiftPoseJacobian<1>(J_rl, parameters[1], jacobians[1]);
     }
-    if (offset_) {
-      double* J = jacobians[extrinsic_ ? 2 : 1];
-      if (J != nullptr) {
-        const Vec3 dy = g_.twist.head<3>() + g_.twist.tail<3>().cross(y);  // dz/dε = C_E·dy
-        J[0] = -a_body.dot(dy);                                            // dε/dδ = −1
-      }
-    }
+    if (offset_ && jacobians[extrinsic_ ? 2 : 1] != nullptr)
+      jacobians[extrinsic_ ? 2 : 1][0] = J_delta;
     return true;
+  }
+
+  using Row6 = Eigen::Matrix<double, 1, 6>;
+  // The residual at T_wb, T_rl and E = Exp(ε·ξ) and its Jacobians on the tangent spaces (the
+  // header's; nullptr: not wanted), for one point: the one evaluation of this factor and of the
+  // batch of a scan's points (point_to_plane_world_calibrated_batch.h).
+  static double EvaluateTangent(const PlaneAssociation& m, const Vec3& q_l, const SE3& deskew,
+                                const Vec6& twist, const SE3& T_wb, const SE3& T_rl, const SE3& E,
+                                Row6* J_wb, Row6* J_rl, double* J_delta) {
+    const Vec3 x = T_rl * q_l;
+    const Vec3 y = deskew * x;
+    const Vec3 p = T_wb * (E * y);
+    const double e = m.weight * m.plane_normal.dot(m.plane_point - p);
+    if (J_wb == nullptr && J_rl == nullptr && J_delta == nullptr) return e;
+    const Eigen::Matrix<double, 1, 3> a = -m.weight * m.plane_normal.transpose();  // de/dp
+    if (J_wb != nullptr) *J_wb = a * se3::PointJacobian(p);
+    const Eigen::Matrix<double, 1, 3> a_body = a * T_wb.rotation() * E.rotation();  // de/dy
+    if (J_rl != nullptr) *J_rl = a_body * deskew.rotation() * se3::PointJacobian(x);
+    if (J_delta != nullptr) {
+      const Vec3 dy = twist.head<3>() + twist.tail<3>().cross(y);  // dz/dε = C_E·dy
+      *J_delta = -a_body.dot(dy);                                  // dε/dδ = −1
+    }
+    return e;
   }
 
   // The next association round of the same point, with that round's deskew and twist (between

@@ -109,6 +109,15 @@ struct CalibrationOptions {
   // docs/experiments/calibration.md, "The write rule".
   double write_max_sigma_ratio = 0.1;
   double write_max_unobservable_fraction = 0.5;
+  // Either way, an estimate that moved by more than `write_max_drift_sigmas` × its final σ over
+  // the second half of the run's scans with nothing held is not written (the start is kept): an
+  // honest converging estimate moves by at most about σ there, a drifting one steadily. Why: the
+  // window's σ of a drifting coordinate need not be large, nor the check's share: on tuning run
+  // slow/101 δ ended 11 ms off with σ 0.44 ms (below 0.5 ms) and was flagged after 2% of the
+  // scans; it moved 7.4σ over the second half, slow/100's 3.0σ (φ up to 5.4σ), where every
+  // coordinate of walking/medium/fast 100–101 moved ≤ 0.3σ. 0: no drift check.
+  // docs/experiments/calibration.md, "The write rule".
+  double write_max_drift_sigmas = 2.5;
 
   // Set by the held pass of a warm-up replay, not read from YAML: C_mi stays held (as with
   // window.estimate_gravity false and no extrinsic estimated) although the extrinsic is
