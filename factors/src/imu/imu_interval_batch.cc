@@ -28,6 +28,13 @@ double* JacobianRow(double** jacobians, int b, int row) {
 ImuIntervalBatch::ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, double t_k1,
                                    std::vector<Sample> samples, const Options& options,
                                    std::shared_ptr<const ceres::LossFunction> accel_loss)
+    : ImuIntervalBatch(model, t_k, t_k1, std::move(samples), options, std::move(accel_loss),
+                       /*own_interpolators=*/true) {}
+
+ImuIntervalBatch::ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                                   std::vector<Sample> samples, const Options& options,
+                                   std::shared_ptr<const ceres::LossFunction> accel_loss,
+                                   bool own_interpolators)
     : model_(model),
       t_k_(t_k),
       t_k1_(t_k1),
@@ -47,7 +54,7 @@ ImuIntervalBatch::ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, 
       if (!(s.time >= t_k && s.time <= t_k1)) {
         throw std::invalid_argument("ImuIntervalBatch: a sample's time is outside the interval");
       }
-      interpolators_.emplace_back(model_, t_k, t_k1, s.time);
+      if (own_interpolators) interpolators_.emplace_back(model_, t_k, t_k1, s.time);
     }
     gyro_.emplace_back(s.gyro, options_.gyro_covariance, options_.mounting);
     if (options_.accelerometer) {
@@ -65,21 +72,57 @@ ImuIntervalBatch::ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, 
   }
 }
 
-void ImuIntervalBatch::Interpolate(size_t i, double const* const* parameters,
-                                   const gp::KnotState& k, const gp::LocalVariables* local,
-                                   bool knot_jacobians, bool rate,
-                                   internal::TimeShiftedState* state) const {
+ImuIntervalBatch::ImuIntervalBatch(
+    const gp::SingerModel<6>& model, double t_k, double t_k1, std::vector<Sample> samples,
+    std::vector<std::shared_ptr<gp::SharedStateInterpolation>> states, const Options& options,
+    std::shared_ptr<const ceres::LossFunction> accel_loss)
+    : ImuIntervalBatch(model, t_k, t_k1, std::move(samples), options, std::move(accel_loss),
+                       /*own_interpolators=*/false) {
+  if (options_.estimate_time_offset || states.size() != samples_.size()) {
+    throw std::invalid_argument(
+        "ImuIntervalBatch: shared states need fixed times and one state per sample");
+  }
+  for (auto& state : states) {
+    state->AddRows(rows_);
+    states_.push_back(std::move(state));
+  }
+}
+
+std::optional<gp::LocalVariables> ImuIntervalBatch::Local(double const* const* parameters,
+                                                          const gp::KnotState& k,
+                                                          bool knot_jacobians) const {
+  if (options_.estimate_time_offset || !states_.empty()) return std::nullopt;
+  return gp::LocalVariables(k, gp::ReadKnotState(parameters[3], parameters[4], parameters[5]),
+                            knot_jacobians);
+}
+
+ImuIntervalBatch::View ImuIntervalBatch::Interpolate(
+    size_t i, double const* const* parameters, const gp::KnotState& k,
+    const std::optional<gp::LocalVariables>& local, bool knot_jacobians, bool rate,
+    internal::TimeShiftedState* scratch,
+    gp::SharedStateInterpolation::Result* shared_scratch) const {
   if (options_.estimate_time_offset) {
     internal::InterpolateShifted(model_, t_k_, t_k1_, samples_[i].time,
                                  parameters[offset_block()][0], rows_, parameters, knot_jacobians,
-                                 rate, state);
-    return;
+                                 rate, scratch);
+    return {&scratch->x,    &scratch->J_k, &scratch->J_k1,
+            &scratch->rate, scratch->s,    scratch->ds_ddelta};
   }
-  interpolators_[i].StateRows(k, *local, rows_, &state->x, knot_jacobians ? &state->J_k : nullptr,
-                              knot_jacobians ? &state->J_k1 : nullptr);
+  if (!states_.empty()) {
+    const gp::SharedStateInterpolation::Result& r =
+        states_[i]->State(parameters, rows_, knot_jacobians, shared_scratch);
+    return {&r.x, &r.J_k, &r.J_k1, nullptr, states_[i]->fraction(), 0.0};
+  }
+  interpolators_[i].StateRows(k, *local, rows_, &scratch->x,
+                              knot_jacobians ? &scratch->J_k : nullptr,
+                              knot_jacobians ? &scratch->J_k1 : nullptr);
   // As gp::SharedStateInterpolation::fraction().
-  state->s = (samples_[i].time - t_k_) / (t_k1_ - t_k_);
-  state->ds_ddelta = 0.0;
+  return {&scratch->x,
+          &scratch->J_k,
+          &scratch->J_k1,
+          nullptr,
+          (samples_[i].time - t_k_) / (t_k1_ - t_k_),
+          0.0};
 }
 
 bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residuals,
@@ -91,29 +134,28 @@ bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residua
   const Eigen::Map<const Vec6> b_k(parameters[6]), b_k1(parameters[7]);
   const Mat3 C_mi = accel ? RotationManifold::Rotation(parameters[g_block]) : Mat3::Identity();
   const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
-  // At fixed times the knot-dependent part γ_{k+1} once for every sample.
-  std::optional<gp::LocalVariables> local;
-  if (d_block < 0) {
-    local.emplace(k, gp::ReadKnotState(parameters[3], parameters[4], parameters[5]),
-                  knot_jacobians);
-  }
+  // At fixed times, unshared, the knot-dependent part γ_{k+1} once for every sample.
+  const std::optional<gp::LocalVariables> local = Local(parameters, k, knot_jacobians);
   const int num_blocks = static_cast<int>(parameter_block_sizes().size());
-  internal::TimeShiftedState st;
+  internal::TimeShiftedState scratch;
+  gp::SharedStateInterpolation::Result shared_scratch;
   internal::AccelResidual::Linearisation lin;
   double cost_gap = 0.0;  // Σ ρ − ρ'·‖e_a‖², in sample order
   for (size_t i = 0; i < samples_.size(); ++i) {
-    Interpolate(i, parameters, k, local ? &*local : nullptr, knot_jacobians, rate, &st);
+    const View st =
+        Interpolate(i, parameters, k, local, knot_jacobians, rate, &scratch, &shared_scratch);
     const double s = st.s;
     const int row_g = rows_per_sample_ * static_cast<int>(i), row_a = row_g + 3;
     // Gyro rows, as ImuGyroMeasurement(WithTimeOffset).
     const Vec3 bg = (1.0 - s) * b_k.tail<3>() + s * b_k1.tail<3>();
-    Eigen::Map<Vec3>{residuals + row_g} = gyro_[i].Evaluate(st.x, bg);
+    Eigen::Map<Vec3>{residuals + row_g} = gyro_[i].Evaluate(*st.x, bg);
     if (jacobians != nullptr) {
       if (knot_jacobians) {
-        WriteKnotJacobians(gyro_[i].Chain(st.J_k), parameters[0], JacobianRow(jacobians, 0, row_g),
+        WriteKnotJacobians(gyro_[i].Chain(*st.J_k), parameters[0], JacobianRow(jacobians, 0, row_g),
                            JacobianRow(jacobians, 1, row_g), JacobianRow(jacobians, 2, row_g));
-        WriteKnotJacobians(gyro_[i].Chain(st.J_k1), parameters[3], JacobianRow(jacobians, 3, row_g),
-                           JacobianRow(jacobians, 4, row_g), JacobianRow(jacobians, 5, row_g));
+        WriteKnotJacobians(gyro_[i].Chain(*st.J_k1), parameters[3],
+                           JacobianRow(jacobians, 3, row_g), JacobianRow(jacobians, 4, row_g),
+                           JacobianRow(jacobians, 5, row_g));
       }
       internal::WriteBiasJacobians(gyro_[i].sqrt_information(), s, 3,
                                    JacobianRow(jacobians, 6, row_g),
@@ -124,7 +166,7 @@ bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residua
       if (rate) {
         // ∂e_g/∂δ = D·ẋ(τ) − S·db_g/dτ (imu_gyro_time_offset.h).
         Eigen::Map<Vec3>{jacobians[d_block] + row_g} =
-            gyro_[i].Chain(st.rate) -
+            gyro_[i].Chain(*st.rate) -
             st.ds_ddelta * gyro_[i].sqrt_information() * (b_k1.tail<3>() - b_k.tail<3>());
       }
     }
@@ -132,7 +174,7 @@ bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residua
 
     // Accelerometer rows, as ImuAccelMeasurement(WithTimeOffset), then the sample's loss.
     const Vec3 ba = (1.0 - s) * b_k.head<3>() + s * b_k1.head<3>();
-    const Vec3 e = accel_[i].Evaluate(st.x, C_mi, ba, jacobians != nullptr ? &lin : nullptr);
+    const Vec3 e = accel_[i].Evaluate(*st.x, C_mi, ba, jacobians != nullptr ? &lin : nullptr);
     double scale = 1.0;
     if (loss_ != nullptr) {
       const double sq_norm = e.squaredNorm();
@@ -145,10 +187,10 @@ bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residua
     Eigen::Map<Vec3>{residuals + row_a} = scale * e;
     if (jacobians == nullptr) continue;
     if (knot_jacobians) {
-      WriteKnotJacobians(accel_[i].Chain(lin, st.J_k), parameters[0],
+      WriteKnotJacobians(accel_[i].Chain(lin, *st.J_k), parameters[0],
                          JacobianRow(jacobians, 0, row_a), JacobianRow(jacobians, 1, row_a),
                          JacobianRow(jacobians, 2, row_a));
-      WriteKnotJacobians(accel_[i].Chain(lin, st.J_k1), parameters[3],
+      WriteKnotJacobians(accel_[i].Chain(lin, *st.J_k1), parameters[3],
                          JacobianRow(jacobians, 3, row_a), JacobianRow(jacobians, 4, row_a),
                          JacobianRow(jacobians, 5, row_a));
     }
@@ -162,7 +204,7 @@ bool ImuIntervalBatch::Evaluate(double const* const* parameters, double* residua
     if (rate) {
       // ∂e_a/∂δ = D·ẋ(τ) − S·db_a/dτ (imu_accel_time_offset.h).
       Eigen::Map<Vec3>{jacobians[d_block] + row_a} =
-          accel_[i].Chain(lin, st.rate) -
+          accel_[i].Chain(lin, *st.rate) -
           st.ds_ddelta * accel_[i].sqrt_information() * (b_k1.head<3>() - b_k.head<3>());
     }
     if (scale == 1.0) continue;
@@ -193,18 +235,16 @@ bool ImuIntervalBatch::ChiSquare(double const* const* parameters, double* accel,
   const Mat3 C_mi =
       options_.accelerometer ? RotationManifold::Rotation(parameters[8]) : Mat3::Identity();
   const gp::KnotState k = gp::ReadKnotState(parameters[0], parameters[1], parameters[2]);
-  std::optional<gp::LocalVariables> local;
-  if (!options_.estimate_time_offset) {
-    local.emplace(k, gp::ReadKnotState(parameters[3], parameters[4], parameters[5]), false);
-  }
-  internal::TimeShiftedState st;
+  const std::optional<gp::LocalVariables> local = Local(parameters, k, false);
+  internal::TimeShiftedState scratch;
+  gp::SharedStateInterpolation::Result shared_scratch;
   for (size_t i = 0; i < samples_.size(); ++i) {
-    Interpolate(i, parameters, k, local ? &*local : nullptr, false, false, &st);
+    const View st = Interpolate(i, parameters, k, local, false, false, &scratch, &shared_scratch);
     const double s = st.s;
-    *gyro += gyro_[i].Evaluate(st.x, (1.0 - s) * b_k.tail<3>() + s * b_k1.tail<3>()).squaredNorm();
+    *gyro += gyro_[i].Evaluate(*st.x, (1.0 - s) * b_k.tail<3>() + s * b_k1.tail<3>()).squaredNorm();
     if (!options_.accelerometer) continue;
     *accel += accel_[i]
-                  .Evaluate(st.x, C_mi, (1.0 - s) * b_k.head<3>() + s * b_k1.head<3>(), nullptr)
+                  .Evaluate(*st.x, C_mi, (1.0 - s) * b_k.head<3>() + s * b_k1.head<3>(), nullptr)
                   .squaredNorm();
   }
   return std::isfinite(*accel) && std::isfinite(*gyro);

@@ -25,6 +25,14 @@
 // row: Evaluate returns false there. Without a loss there is no extra row and the block is an
 // ordinary cost function (its Jacobians are checked numerically).
 //
+// Shared interpolations. Given one gp::SharedStateInterpolation per sample (the second
+// constructor), the block reads x(τ_i) from it: a window's evaluation callback prepares them once
+// per evaluation point, with the Jacobians and the interval's local variables shared with the
+// lidar interpolations on the same knots, and on several threads with window.threads
+// (solvers/shared_interpolation_callback.h); the Jacobian evaluation at an accepted point then
+// reads what the cost evaluation there prepared. Without them the block interpolates itself, on
+// every evaluation (what a caller outside a window's solve, e.g. a gradient check, gets).
+//
 // Time offset (imu_gyro_time_offset.h, imu_accel_time_offset.h): with estimate_time_offset each
 // sample's time is its stamp t and it measures x(t + δ), δ a last parameter block; the
 // interpolation is formed at τ = t + δ on every evaluation (clamped to the interval, as the
@@ -39,10 +47,12 @@
 #include <ceres/loss_function.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/motion_model.h"
+#include "ctlio/factors/gp/shared_state_interpolation.h"
 #include "ctlio/factors/imu/imu_mounting.h"
 #include "ctlio/factors/imu/imu_residual.h"
 #include "ctlio/manifolds/types.h"
@@ -73,6 +83,15 @@ class ImuIntervalBatch final : public ceres::CostFunction {
                    std::vector<Sample> samples, const Options& options,
                    std::shared_ptr<const ceres::LossFunction> accel_loss = nullptr);
 
+  // At fixed times, reading sample i's state from states[i] (at τ_i = samples[i].time between the
+  // interval's knots, its six knot blocks those of this block), which the block asks for the
+  // rows it reads; not with estimate_time_offset.
+  ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                   std::vector<Sample> samples,
+                   std::vector<std::shared_ptr<gp::SharedStateInterpolation>> states,
+                   const Options& options,
+                   std::shared_ptr<const ceres::LossFunction> accel_loss = nullptr);
+
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -90,19 +109,34 @@ class ImuIntervalBatch final : public ceres::CostFunction {
   }
 
  private:
-  // x(τ_i) into *state (its knot Jacobians' rows with `knot_jacobians`, its rate with `rate`):
-  // at a fixed time from the interval's local variables `local` (k: knot k's values), with the
-  // estimated offset at the stamp + δ.
-  void Interpolate(size_t i, double const* const* parameters, const gp::KnotState& k,
-                   const gp::LocalVariables* local, bool knot_jacobians, bool rate,
-                   internal::TimeShiftedState* state) const;
+  // x(τ_i), its knot Jacobians' rows (with `knot_jacobians`), its rate (with `rate`) and s(τ_i).
+  ImuIntervalBatch(const gp::SingerModel<6>& model, double t_k, double t_k1,
+                   std::vector<Sample> samples, const Options& options,
+                   std::shared_ptr<const ceres::LossFunction> accel_loss, bool own_interpolators);
+
+  struct View {
+    const gp::KnotState* x;
+    const gp::StateJacobian *J_k, *J_k1;
+    const gp::StateRate* rate;
+    double s, ds_ddelta;
+  };
+  // From the shared state, or formed into the scratch: at a fixed time from the interval's local
+  // variables `local` (k: knot k's values), with the estimated offset at the stamp + δ.
+  View Interpolate(size_t i, double const* const* parameters, const gp::KnotState& k,
+                   const std::optional<gp::LocalVariables>& local, bool knot_jacobians, bool rate,
+                   internal::TimeShiftedState* scratch,
+                   gp::SharedStateInterpolation::Result* shared_scratch) const;
+  // The local variables at `parameters` for the samples not read from shared states.
+  std::optional<gp::LocalVariables> Local(double const* const* parameters, const gp::KnotState& k,
+                                          bool knot_jacobians) const;
 
   gp::SingerModel<6> model_;
   double t_k_, t_k1_;
   std::vector<Sample> samples_;
   Options options_;
   std::shared_ptr<const ceres::LossFunction> loss_;
-  std::vector<gp::GpInterpolator> interpolators_;  // at fixed times, one per sample
+  std::vector<gp::GpInterpolator> interpolators_;  // at fixed times, unshared, one per sample
+  std::vector<std::shared_ptr<const gp::SharedStateInterpolation>> states_;  // or shared ones
   std::vector<internal::GyroResidual> gyro_;
   std::vector<internal::AccelResidual> accel_;
   unsigned rows_;  // the state rows both residuals read
