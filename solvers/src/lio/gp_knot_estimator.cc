@@ -141,7 +141,9 @@ std::optional<Vec6> GpKnotEstimator::MeanTwist(const Knot& prev) const {
   std::vector<TimedState> window_states;
   for (const Knot& k : knots_) window_states.push_back(ValueOf(k));
   for (auto it = window_states.rbegin(); it != window_states.rend(); ++it) consider(*it);
-  for (auto it = history_.rbegin(); it != history_.rend(); ++it) consider(*it);
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+    if (it->t < knots_.front().t) consider(*it);  // not a stale copy of a window knot
+  }
   if (ref == nullptr || prev.t - ref->t < 0.1 * span) return std::nullopt;
   const SE3 T_prev = PoseManifold::Pose(prev.pose);
   return Vec6((T_prev * ref->x.pose.Inverse()).Log() / (prev.t - ref->t));
@@ -155,10 +157,6 @@ std::vector<SE3> GpKnotEstimator::SealOldest(const std::vector<double>& t) {
   chain.push_back(ValueOf(knots_.front()));
   std::vector<SE3> poses = PosesOver(chain, t);
   sealed_ = chain.back();
-  history_.push_back(*sealed_);
-  while (history_.size() > 1 && history_[1].t <= sealed_->t - config_.gap_prediction_span) {
-    history_.pop_front();
-  }
   return poses;
 }
 
@@ -245,6 +243,14 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                ScanResult* result) {
   // K knots over the sweep: at t_prev + (i/K)·Δt, the last exactly at the scan end.
   imu_blocks_.clear();
+  // The oldest knot, solved at least once: kept for the mean twist of an IMU outage (MeanTwist).
+  const Knot& held = knots_.front();
+  if (config_.gap_prediction_span > 0.0 && (history_.empty() || history_.back().t < held.t)) {
+    history_.push_back(ValueOf(held));
+    while (history_.size() > 1 && history_[1].t <= held.t - config_.gap_prediction_span) {
+      history_.pop_front();
+    }
+  }
   const int K = config_.knots_per_scan;
   const double t_prev = knots_.back().t;
   for (int i = 1; i <= K; ++i) {

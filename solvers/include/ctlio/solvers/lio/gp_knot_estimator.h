@@ -132,8 +132,9 @@ class GpKnotEstimator final : public Estimator {
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
   std::optional<TimedState> sealed_;       // the final value of the knot sealed last
-  // Sealed knots of the last window.gap_prediction_span seconds, oldest first (the mean twist a
-  // knot in an IMU outage starts from).
+  // The oldest knot at each AddState (solved at least once) over the last
+  // window.gap_prediction_span seconds, oldest first: where the mean twist a knot in an IMU
+  // outage starts from reaches back to.
   std::deque<TimedState> history_;
   ImuTermBlocks imu_blocks_;  // those the last AddState added
 };

@@ -134,10 +134,11 @@ struct OdometryConfig {
   // IMU outage) starts from the previous knot moved by the mean twist of the estimate over the
   // last gap_prediction_span seconds, Log(T_k·T_{k−span}⁻¹)/span, with ϖ̇ = 0; 0: the previous
   // knot's own ϖ (constant body velocity). The mean follows travel but not vibration: in the
-  // fast regime ϖ swings ±1–2 rad/s at 4–8 Hz, so carrying the last ϖ through a 0.1 s sweep
-  // started ~10° off and the lidar lost the scan (docs/experiments/imu-batch.md). Only the
-  // solver's starting point changes.
-  double gap_prediction_span = 0.5;
+  // fast regime ϖ swings ±1–2 rad/s at 4–8 Hz, and carried through a 0.1 s sweep from the last
+  // knot it started the solve ~10° off, where the sparse lidar lost the scan. 1 s: fast-regime
+  // 1 s outages bridged (0.5 s and 2 s worse on the VLP-16-like sensor: 2.9 and 0.28 m against
+  // 0.17 m; docs/experiments/imu-batch.md). Only the solver's starting point changes.
+  double gap_prediction_span = 1.0;
 
   // --- Sensor setup.
   SE3 T_imu_lidar;  // lidar → robot (IMU) frame
