@@ -69,6 +69,35 @@ inline Vec3 Evaluate(const ceres::CostFunction& cost, const std::vector<const do
   return r;
 }
 
+// A time-offset factor with δ in milliseconds (its last block; Jacobian column scaled by 1e-3). The
+// gradient check's Ridders differences start at a step of 1e-3·max(|x|, 1) in the block's own units
+// (common/gradient_check.h): 1 ms on a block in seconds, over which the interpolated acceleration
+// of these random knots is far from its Taylor polynomial, so the extrapolation settles at ~1e-5
+// (a central difference at 1e-7 s agrees with the analytic ∂e/∂δ to ~4e-10 relative). In
+// milliseconds the first step is 1 µs.
+class DeltaInMilliseconds final : public ceres::CostFunction {
+ public:
+  explicit DeltaInMilliseconds(const ceres::CostFunction& cost) : cost_(cost) {
+    set_num_residuals(cost.num_residuals());
+    *mutable_parameter_block_sizes() = cost.parameter_block_sizes();
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = static_cast<int>(parameter_block_sizes().size());
+    std::vector<const double*> p(parameters, parameters + n);
+    const double delta_s = 1e-3 * parameters[n - 1][0];
+    p[n - 1] = &delta_s;
+    if (!cost_.Evaluate(p.data(), residuals, jacobians)) return false;
+    if (jacobians != nullptr && jacobians[n - 1] != nullptr) {
+      for (int r = 0; r < num_residuals(); ++r) jacobians[n - 1][r] *= 1e-3;
+    }
+    return true;
+  }
+
+ private:
+  const ceres::CostFunction& cost_;
+};
+
 // Knots for the Jacobian checks of trial 0–5: generic rotations (0, 1), |φ| near π (2, 3; trial 3
 // also turns by 3 rad between the knots), near-identity with tiny motion (4, 5); random ϖ, ϖ̇,
 // biases and C_mi.

@@ -29,35 +29,6 @@ std::vector<const double*> With(std::vector<const double*> p, const double* delt
   return p;
 }
 
-// The factor with δ in milliseconds (the last block; Jacobian column scaled by 1e-3). The gradient
-// check's Ridders differences start at a step of 1e-3·max(|x|, 1) in the block's own units
-// (common/gradient_check.h): 1 ms on a block in seconds, over which the interpolated acceleration
-// of these random knots is far from its Taylor polynomial, so the extrapolation settles at ~1e-5
-// (a central difference at 1e-7 s agrees with the analytic ∂e/∂δ to ~4e-10 relative). In
-// milliseconds the first step is 1 µs.
-class DeltaInMilliseconds final : public ceres::CostFunction {
- public:
-  explicit DeltaInMilliseconds(const ceres::CostFunction& cost) : cost_(cost) {
-    set_num_residuals(cost.num_residuals());
-    *mutable_parameter_block_sizes() = cost.parameter_block_sizes();
-  }
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const int n = static_cast<int>(parameter_block_sizes().size());
-    std::vector<const double*> p(parameters, parameters + n);
-    const double delta_s = 1e-3 * parameters[n - 1][0];
-    p[n - 1] = &delta_s;
-    if (!cost_.Evaluate(p.data(), residuals, jacobians)) return false;
-    if (jacobians != nullptr && jacobians[n - 1] != nullptr) {
-      for (int r = 0; r < num_residuals(); ++r) jacobians[n - 1][r] *= 1e-3;
-    }
-    return true;
-  }
-
- private:
-  const ceres::CostFunction& cost_;
-};
-
 ImuMounting TiltedLeverArm() {
   ImuMounting m;
   m.C_ri = so3::Exp(Vec3(0.3, -0.7, 1.1));
@@ -121,13 +92,13 @@ TEST(ImuTimeOffset, JacobiansMatchNumeric) {
       for (const SingerModel<6>& model : Models()) {
         ++model_index;
         const ImuGyroMeasurementWithTimeOffset gyro(model, t_k, t_k1, stamp, meas, cov, mounting);
-        EXPECT_TRUE(testing::JacobiansMatchNumeric(DeltaInMilliseconds(gyro), gyro_m,
+        EXPECT_TRUE(testing::JacobiansMatchNumeric(testing::DeltaInMilliseconds(gyro), gyro_m,
                                                    With(blocks.Gyro(), &delta_ms), 1e-6))
             << "gyro trial " << trial << " prior " << model_index;
         for (const AccelModel m : {AccelModel::kBodyCentric, AccelModel::kSpecificForce}) {
           const ImuAccelMeasurementWithTimeOffset accel(model, t_k, t_k1, stamp, meas, cov, 9.81, m,
                                                         mounting);
-          EXPECT_TRUE(testing::JacobiansMatchNumeric(DeltaInMilliseconds(accel), accel_m,
+          EXPECT_TRUE(testing::JacobiansMatchNumeric(testing::DeltaInMilliseconds(accel), accel_m,
                                                      With(blocks.Accel(), &delta_ms), 1e-6))
               << "accel trial " << trial << " model " << static_cast<int>(m) << " prior "
               << model_index;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "ctlio/factors/gp/singer_prior.h"
 #include "ctlio/factors/imu/imu_accel_time_offset.h"
 #include "ctlio/factors/imu/imu_gyro_time_offset.h"
+#include "ctlio/factors/imu/imu_interval_batch.h"
 #include "ctlio/factors/imu/imu_measurement.h"
 #include "ctlio/factors/priors/euclidean_prior.h"
 #include "ctlio/factors/priors/pose_prior.h"
@@ -127,6 +129,26 @@ std::vector<double> GpKnotEstimator::StateTimes() const {
   return t;
 }
 
+std::optional<Vec6> GpKnotEstimator::MeanTwist(const Knot& prev) const {
+  const double span = config_.gap_prediction_span;
+  if (span <= 0.0) return std::nullopt;
+  // The states before prev, newest first: the window's knots, then the sealed ones.
+  const TimedState* ref = nullptr;
+  const auto consider = [&](const TimedState& s) {
+    if (s.t >= prev.t || (ref != nullptr && ref->t <= prev.t - span)) return;
+    ref = &s;
+  };
+  std::vector<TimedState> window_states;
+  for (const Knot& k : knots_) window_states.push_back(ValueOf(k));
+  for (auto it = window_states.rbegin(); it != window_states.rend(); ++it) consider(*it);
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+    if (it->t < knots_.front().t) consider(*it);  // not a stale copy of a window knot
+  }
+  if (ref == nullptr || prev.t - ref->t < 0.1 * span) return std::nullopt;
+  const SE3 T_prev = PoseManifold::Pose(prev.pose);
+  return Vec6((T_prev * ref->x.pose.Inverse()).Log() / (prev.t - ref->t));
+}
+
 std::vector<SE3> GpKnotEstimator::SealOldest(const std::vector<double>& t) {
   // Both knots' full GP states at their final values: the interpolation of the factors (SPEC §2)
   // between them is the final estimate of the interval.
@@ -221,6 +243,14 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
                                ScanResult* result) {
   // K knots over the sweep: at t_prev + (i/K)·Δt, the last exactly at the scan end.
   imu_blocks_.clear();
+  // The oldest knot, solved at least once: kept for the mean twist of an IMU outage (MeanTwist).
+  const Knot& held = knots_.front();
+  if (config_.gap_prediction_span > 0.0 && (history_.empty() || history_.back().t < held.t)) {
+    history_.push_back(ValueOf(held));
+    while (history_.size() > 1 && history_[1].t <= held.t - config_.gap_prediction_span) {
+      history_.pop_front();
+    }
+  }
   const int K = config_.knots_per_scan;
   const double t_prev = knots_.back().t;
   for (int i = 1; i <= K; ++i) {
@@ -270,8 +300,11 @@ gp::KnotState GpKnotEstimator::InitialGuess(const Knot& prev, double t,
   int j = 0;
   while (j < num_imus() && imu[j].empty()) ++j;
   if (j == num_imus()) {
-    // Constant body velocity, ϖ̇ = 0.
-    return {SE3::Exp(dt * x.velocity) * x.pose, x.velocity, Vec6::Zero()};
+    // No IMU sample (an outage): the mean twist of the recent estimate, else constant body
+    // velocity; ϖ̇ = 0 (odometry_config.h, gap_prediction_span).
+    const std::optional<Vec6> mean = MeanTwist(prev);
+    const Vec6 w = mean ? *mean : x.velocity;
+    return {SE3::Exp(dt * w) * x.pose, w, Vec6::Zero()};
   }
   const Vec6 bias = Eigen::Map<const Vec6>(prev.bias[j]);
   if (!config_.imu_prediction) {
@@ -319,6 +352,49 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
   bool accel_loss_used = false;
   const gp::KnotBlocks knots = {prev.pose, prev.velocity, prev.acceleration,
                                 k.pose,    k.velocity,    k.acceleration};
+  if (config_.imu_residual_blocks == "interval") {
+    // One block for the interval's samples, the per-sample residuals below in one evaluation
+    // (imu_interval_batch.h), with each accelerometer sample's loss inside the block.
+    if (imu.empty()) return;
+    imu::ImuIntervalBatch::Options o;
+    o.gyro_covariance = gyro_cov;
+    o.accel_covariance = accel_cov;
+    o.gravity = config_.gravity;
+    o.accel_model = accel_model;
+    o.mounting = mounting;
+    o.accelerometer = config_.method == LioMethod::kSingerLio;
+    o.estimate_time_offset = time_offsets() && config_.calibration.estimate_time_offset;
+    const double delta = time_offsets() ? TimeOffset(imu_index, *window) : 0.0;
+    std::vector<imu::ImuIntervalBatch::Sample> samples;
+    std::vector<std::shared_ptr<gp::SharedStateInterpolation>> shared;
+    samples.reserve(imu.size());
+    for (const ImuSample& s : imu) {
+      const double stamp = imu_.Seconds(s.t_ns);
+      // As below: the stamp (offset estimated), the stamp + a held offset on the interval, or
+      // the stamp.
+      const double time = !time_offsets() || o.estimate_time_offset
+                              ? stamp
+                              : std::clamp(stamp + delta, prev.t, k.t);
+      samples.push_back({time, s.gyro, s.accel});
+      if (o.estimate_time_offset) continue;
+      // At a fixed time the window's evaluation callback prepares the sample's state once per
+      // evaluation point, as for the per-sample blocks.
+      shared.push_back(
+          std::make_shared<gp::SharedStateInterpolation>(model_, prev.t, k.t, time, knots));
+      window->shared_interpolations().Add(shared.back());
+    }
+    std::vector<StateId> states = o.accelerometer ? accel_states : gyro_states;
+    if (o.estimate_time_offset) states.push_back(TimeOffsetKey(imu_index));
+    std::shared_ptr<const ceres::LossFunction> loss(std::move(accel_loss));
+    auto* batch = o.estimate_time_offset
+                      ? new imu::ImuIntervalBatch(model_, prev.t, k.t, std::move(samples), o, loss)
+                      : new imu::ImuIntervalBatch(model_, prev.t, k.t, std::move(samples),
+                                                  std::move(shared), o, loss);
+    const ceres::ResidualBlockId id = window->AddResidualBlock(batch, nullptr, states);
+    (o.accelerometer ? imu_blocks_.accel : imu_blocks_.gyro).push_back(id);
+    result->imu_residuals += static_cast<int>((o.accelerometer ? 2 : 1) * imu.size());
+    return;
+  }
   if (time_offsets()) {
     const double delta = TimeOffset(imu_index, *window);
     for (const ImuSample& s : imu) {

@@ -131,6 +131,10 @@ void OdometryConfig::Validate() const {
   require((alpha.array() >= 0).all(), "gp.alpha must be >= 0 on every axis");
   require(accel_variance > 0 && gyro_variance > 0, "imu variances must be positive");
   require(accel_loss_scale >= 0, "imu.accel_loss_scale must be >= 0");
+  require(imu_residual_blocks == "sample" || imu_residual_blocks == "interval",
+          "imu.residual_blocks must be sample or interval");
+  require(gap_prediction_span >= 0 && gap_prediction_span <= 10,
+          "window.gap_prediction_span must be in [0, 10] s");
   require(bias_accel_walk > 0 && bias_gyro_walk > 0 && bias_walk_period > 0,
           "bias random walk parameters must be positive");
   require(initial_bias_accel_variance > 0 && initial_bias_gyro_variance > 0,
@@ -233,6 +237,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"gap_velocity_walk", SetFromYaml(&c->gap_velocity_walk)},
                    {"gap_hold_max", SetFromYaml(&c->gap_hold_max)},
                    {"gap_zero_order_hold", SetFromYaml(&c->gap_zero_order_hold)},
+                   {"residual_blocks", SetFromYaml(&c->imu_residual_blocks)},
                    {"input_imu", SetFromYaml(&c->input_imu)}});
     } else if (key == "init") {
       ReadSection(v, section, source,
@@ -251,6 +256,7 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"overlap", SetFromYaml(&c->overlap_stages)},
            {"estimate_gravity", SetFromYaml(&c->estimate_gravity)},
            {"imu_prediction", SetFromYaml(&c->imu_prediction)},
+           {"gap_prediction_span", SetFromYaml(&c->gap_prediction_span)},
            {"pose_covariance", SetFromYaml(&c->pose_covariance)},
            {"pose_covariance_lidar_scale", SetFromYaml(&c->pose_covariance_lidar_scale)},
            {"pose_covariance_adaptive", SetFromYaml(&c->pose_covariance_adaptive)},

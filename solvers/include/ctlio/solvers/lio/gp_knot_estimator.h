@@ -105,6 +105,10 @@ class GpKnotEstimator final : public Estimator {
   // The new knot's starting value at t from the previous knot and the interval's samples per
   // IMU: window.imu_prediction's integration of the IMU (imu_knot_prediction.h), or constant
   // body velocity with the newest gyro sample's rate.
+  // The mean twist of the estimate over the gap_prediction_span seconds before knot `prev`
+  // (Log(T_prev·T_ref⁻¹)/(t_prev − t_ref), T_ref the newest state at least that old, or the
+  // oldest kept), or nothing before a tenth of the span is covered.
+  std::optional<Vec6> MeanTwist(const Knot& prev) const;
   gp::KnotState InitialGuess(const Knot& prev, double t,
                              const std::vector<std::vector<ImuSample>>& imu,
                              const SlidingWindow& window) const;
@@ -128,7 +132,11 @@ class GpKnotEstimator final : public Estimator {
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)
   std::optional<TimedState> sealed_;       // the final value of the knot sealed last
-  ImuTermBlocks imu_blocks_;               // those the last AddState added
+  // The oldest knot at each AddState (solved at least once) over the last
+  // window.gap_prediction_span seconds, oldest first: where the mean twist a knot in an IMU
+  // outage starts from reaches back to.
+  std::deque<TimedState> history_;
+  ImuTermBlocks imu_blocks_;  // those the last AddState added
 };
 
 }  // namespace ctlio::lio

@@ -19,9 +19,11 @@
 namespace ctlio::lio {
 
 // The IMU residual blocks one scan added to the window, by sensor. Singer-LIO: one accelerometer
-// and one gyro block per sample (3 components each); lidar_gyro: gyro blocks only; the IMU-as-input
-// baseline: its preintegrated IMU factor ([φ; v; p], 9 components, driven by both sensors and not
-// separable once whitened) in `accel`, no gyro block.
+// and one gyro block per sample (3 components each), or with imu.residual_blocks: interval one
+// imu::ImuIntervalBatch per interval and IMU in `accel` (it reports each sensor's χ² itself);
+// lidar_gyro: gyro blocks only (or its interval blocks, in `gyro`); the IMU-as-input baseline: its
+// preintegrated IMU factor ([φ; v; p], 9 components, driven by both sensors and not separable once
+// whitened) in `accel`, no gyro block.
 struct ImuTermBlocks {
   std::vector<ceres::ResidualBlockId> accel;
   std::vector<ceres::ResidualBlockId> gyro;
