@@ -5,7 +5,7 @@
 //     along excited axes; a platform that does not rotate excites no axis (no rotation verdict);
 //   * end to end on a short simulated sequence (fixed seed), both methods: the clean run is not
 //     warned about, the sign-flipped and the x↔z-swapped accelerometer are — the swapped one passed
-//     the IMU χ² check (imu_consistency_run_test.cc).
+//     the IMU χ² check (imu_consistency_run_test.cc); under --strict the warning is an error.
 #include "lio/frame_consistency.h"
 
 #include <gtest/gtest.h>
@@ -13,12 +13,14 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "common/mutated_source.h"
 #include "common/sim_lio.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/manifolds/so3.h"
 #include "lio/run_odometry.h"
 
@@ -171,6 +173,21 @@ TEST(FrameConsistency, SimulatedFlippedAndSwappedAccelerometersAreWarnedCleanIsN
       }
     }
   }
+}
+
+TEST(FrameConsistency, UnderStrictAnInconsistentRunIsAnError) {
+  testing::MutatedSource source =
+      AccelMutated([](const Vec3& f) { return Vec3(f.z(), f.y(), f.x()); });
+  io::WarningLimiter::SetStrict(true);
+  try {
+    lioapp::RunOdometry(source, testing::SimLioConfig());
+    ADD_FAILURE() << "no error under strict";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the accelerometer disagrees"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("strict"), std::string::npos) << e.what();
+  }
+  io::WarningLimiter::SetStrict(false);
 }
 
 }  // namespace
