@@ -54,17 +54,21 @@ bool GyroRotation(const std::deque<imu::ImuSample>& s, int64_t t0, int64_t t1, M
   });
 }
 
-// "true x, y, z = reading (+z, +y, +x)" when every row of M has one entry above 0.5 in magnitude
-// and they form a permutation; else "".
+// "(+z, +y, +x)" (true x, y, z = reading z, y, x) when M is within 0.4 of a signed permutation
+// entry by entry; else "" (M is no clear relabelling of the axes).
 std::string SignedPermutation(const Mat3& M) {
   std::string out = "(";
   int used = 0;
   for (int i = 0; i < 3; ++i) {
     int j;
-    const double m = M.row(i).cwiseAbs().maxCoeff(&j);
-    if (m < 0.5 || (used & (1 << j))) return "";
+    M.row(i).cwiseAbs().maxCoeff(&j);
+    if (used & (1 << j)) return "";
     used |= 1 << j;
-    out += std::string(i ? ", " : "") + (M(i, j) < 0 ? "-" : "+") + "xyz"[j];
+    const double sign = M(i, j) < 0 ? -1.0 : 1.0;
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(M(i, k) - (k == j ? sign : 0.0)) > 0.4) return "";
+    }
+    out += std::string(i ? ", " : "") + (sign < 0 ? "-" : "+") + "xyz"[j];
   }
   return out + ")";
 }
@@ -248,7 +252,7 @@ FrameConsistency FrameConsistencyCheck::Result() const {
     std::snprintf(text, sizeof(text),
                   "the accelerometer disagrees with the accelerations of the lidar trajectory: "
                   "residual RMS %.3g m/s^2 over %d windows of %.1f s (threshold %.3g; clean "
-                  "simulated runs 0.005 to 0.031); a fitted 3x3 map M (f -> M f) leaves %.3g "
+                  "simulated runs 0.005 to 0.098); a fitted 3x3 map M (f -> M f) leaves %.3g "
                   "(|M - I| = %.2f%s%s): the accelerometer's sign or axes (a flipped or swapped "
                   "column), the IMU's mounting (extrinsic rotation), or a diverged estimate",
                   r.identity_rms, r.windows, 2.0 * options_.half_window_s,
@@ -263,7 +267,7 @@ FrameConsistency FrameConsistencyCheck::Result() const {
     std::snprintf(text, sizeof(text),
                   "the gyro's rotations and the lidar trajectory's differ by a rotation of %.2f "
                   "deg about [%.2f %.2f %.2f] in the IMU frame (%d spans of %.1f s, %d of 3 axes "
-                  "excited; threshold %.3g deg, clean simulated runs up to 0.43): the extrinsic "
+                  "excited; threshold %.3g deg, clean simulated runs up to 0.91): the extrinsic "
                   "rotation (config extrinsic:, the "
                   "dataset's imu_from_lidar or /tf_static) is likely off by about that "
                   "(calibration.estimate_extrinsic: true estimates it), or the gyro's axes are "
