@@ -267,7 +267,7 @@ FrameConsistency FrameConsistencyCheck::Result() const {
     std::snprintf(text, sizeof(text),
                   "the gyro's rotations and the lidar trajectory's differ by a rotation of %.2f "
                   "deg about [%.2f %.2f %.2f] in the IMU frame (%d spans of %.1f s, %d of 3 axes "
-                  "excited; threshold %.3g deg, clean simulated runs up to 0.91): the extrinsic "
+                  "excited; threshold %.3g deg, clean simulated runs up to 1.28): the extrinsic "
                   "rotation (config extrinsic:, the "
                   "dataset's imu_from_lidar or /tf_static) is likely off by about that "
                   "(calibration.estimate_extrinsic: true estimates it), or the gyro's axes are "
