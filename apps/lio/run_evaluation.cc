@@ -72,6 +72,7 @@ void WriteRunEvaluation(const RunSummary& run,
   if (!run.imu_inconsistency.empty()) {
     ev << "imu_inconsistency \"" << run.imu_inconsistency << "\"\n";
   }
+  WriteFrameConsistency(run.frames, ev);
   if (run.overlapping_scans > 0) {
     ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
        << run.first_overlapping_scan << "\"\n";
@@ -236,6 +237,9 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     }
     if (!r.imu_inconsistency.empty()) {
       std::printf("  %-10s WARNING imu: %s\n", r.method.c_str(), r.imu_inconsistency.c_str());
+    }
+    if (!r.frames.warning.empty()) {
+      std::printf("  %-10s WARNING frames: %s\n", r.method.c_str(), r.frames.warning.c_str());
     }
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),

@@ -24,6 +24,7 @@
 #include "ctlio/solvers/lio/config_plausibility.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "extrinsic_agreement.h"
+#include "frame_consistency.h"
 #include "run_checks.h"
 
 namespace ctlio::lioapp {
@@ -290,8 +291,14 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   size_t done = 0;
   std::vector<int64_t> scan_ends;  // of the scans handed to the odometry, for the lidar gaps
   std::optional<std::pair<std::chrono::steady_clock::time_point, int64_t>> pace_origin;
+  // The IMU's frame against the lidar trajectory's (frame_consistency.h); lidar_only uses no IMU.
+  FrameConsistencyCheck frames(config.ImuPose(0));
+  const bool check_frames = config.method != lio::LioMethod::kLidarOnly;
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
-    for (const io::ImuSample& x : frame.imu) odometry->AddImu(x);
+    for (const io::ImuSample& x : frame.imu) {
+      odometry->AddImu(x);
+      if (check_frames) frames.AddImu(x);
+    }
     if (have_previous && frame.end_ns <= previous_end) {
       ++run.scans_skipped;
       recovered("scan " + std::to_string(frame.index) + " would be skipped: its end " +
@@ -323,6 +330,11 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                                         std::chrono::duration<double>(seconds)));
     }
     const lio::ScanResult r = odometry->AddScan(TakeLidarScan(&frame));
+    if (r.status == lio::ScanStatus::kOk && check_frames) {
+      frames.AddPose(r.t_ns, r.T_mr);
+    } else {
+      frames.Break();
+    }
     run.imu_rejected += r.imu_rejected;
     run.points_dropped += r.points_dropped;
     if (r.imu_rejected > 0 || r.points_dropped > 0) {
@@ -436,6 +448,16 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   run.imu_inconsistency = imu.warning;
   if (!imu.warning.empty()) {
     LOG(WARNING) << source.Name() << ": " << run.method << ": " << imu.warning;
+  }
+  if (check_frames) {
+    run.frames = frames.Result();
+    if (!run.frames.warning.empty()) {
+      LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.frames.warning;
+      if (io::WarningLimiter::Strict()) {
+        throw std::runtime_error(source.Name() + ": " + run.method + ": " + run.frames.warning +
+                                 " (--strict / input.strict: an inconsistent input is an error)");
+      }
+    }
   }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||
                 (run.ate && !(run.ate->rmse <= failure_ate)) || run.trajectory.size() < 2 ||

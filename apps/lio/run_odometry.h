@@ -14,6 +14,7 @@
 #include "ctlio/io/dataset.h"
 #include "ctlio/io/warning_limiter.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "frame_consistency.h"
 #include "trajectory_errors.h"
 
 namespace ctlio::lioapp {
@@ -150,6 +151,9 @@ struct RunSummary {
   int imu_consistency_scans = 0;
   double median_accel_chi2 = 0.0, median_gyro_chi2 = 0.0;
   std::string imu_inconsistency;
+  // Lidar–IMU frame consistency (frame_consistency.h): the fits and the warning (empty when
+  // consistent or not judged; not run for lidar_only); not a failure.
+  FrameConsistency frames;
   // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`
   // (the estimate left the room of any sensible error), or the lidar registered no scan.
   bool failure = false;
