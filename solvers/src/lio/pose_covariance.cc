@@ -2,9 +2,10 @@
 
 #include <ceres/covariance.h>
 
-#include <set>
 #include <utility>
 #include <vector>
+
+#include "ctlio/solvers/lio/adaptive_covariance.h"
 
 namespace ctlio::lio {
 
@@ -39,30 +40,11 @@ std::optional<Mat6> ScaledPoseCovariance(const SlidingWindow& window, StateId po
                                          const std::vector<ceres::ResidualBlockId>& lidar,
                                          double lidar_scale, const SE3& T_mr,
                                          const Mat6& tangent_from_body) {
-  std::vector<StateId> ordering;
-  int offset = -1, n = 0;
-  std::set<ceres::ResidualBlockId> others;
-  for (const StateId id : window.StateIds()) {
-    if (window.IsStateConstant(id)) continue;
-    if (id == pose) offset = n;
-    ordering.push_back(id);
-    n += window.TangentSize(id);
-    for (const ceres::ResidualBlockId r : window.ResidualBlocksOf(id)) others.insert(r);
-  }
-  if (offset < 0) return std::nullopt;
-  for (const ceres::ResidualBlockId r : lidar) others.erase(r);
-  Eigen::MatrixXd H, H_lidar;
-  Eigen::VectorXd b;
-  window.Linearize({others.begin(), others.end()}, ordering, &H, &b);
-  window.Linearize(lidar, ordering, &H_lidar, &b);
-  H += H_lidar / lidar_scale;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, 6);
-  E.middleRows(offset, 6).setIdentity();
-  const Mat6 block = E.transpose() * ldlt.solve(E);
-  const Mat6 M = T_mr.Adjoint() * tangent_from_body.inverse();
-  return Mat6(M * block * M.transpose());
+  // One scaled group (the lidar blocks) and no prior rescaling: the adaptive model's general case.
+  const std::optional<GroupScaledCovariance> c = GroupScaledPoseCovariance(
+      window, pose, {ScaledGroup{lidar, lidar_scale}}, nullptr, 1.0, T_mr, tangent_from_body);
+  if (!c) return std::nullopt;
+  return c->scaled;
 }
 
 }  // namespace ctlio::lio
