@@ -5,8 +5,8 @@
 // cost, gradient and Gauss–Newton Hessian of the per-point blocks with that loss.
 #include "ctlio/factors/lidar/point_to_plane_world_calibrated_batch.h"
 
-#include <ceres/loss_function.h>
 #include <ceres/crs_matrix.h>
+#include <ceres/loss_function.h>
 #include <ceres/problem.h>
 #include <gtest/gtest.h>
 
