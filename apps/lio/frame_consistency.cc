@@ -249,16 +249,17 @@ FrameConsistency FrameConsistencyCheck::Result() const {
   char text[1200];
   std::string found;
   if (r.windows >= options_.min_windows && r.identity_rms > options_.max_identity_rms) {
-    std::snprintf(text, sizeof(text),
-                  "the accelerometer disagrees with the accelerations of the lidar trajectory: "
-                  "residual RMS %.3g m/s^2 over %d windows of %.1f s (threshold %.3g; clean "
-                  "simulated runs 0.005 to 0.098); a fitted 3x3 map M (f -> M f) leaves %.3g "
-                  "(|M - I| = %.2f%s%s): the accelerometer's sign or axes (a flipped or swapped "
-                  "column), the IMU's mounting (extrinsic rotation), or a diverged estimate",
-                  r.identity_rms, r.windows, 2.0 * options_.half_window_s,
-                  options_.max_identity_rms, r.free_rms, r.map_deviation,
-                  r.map_reading.empty() ? "" : ", true (x, y, z) = reading ",
-                  r.map_reading.c_str());
+    std::snprintf(
+        text, sizeof(text),
+        "the accelerometer disagrees with the accelerations of the lidar trajectory: "
+        "residual RMS %.3g m/s^2 over %d windows of %.1f s (threshold %.3g; clean "
+        "simulated runs 0.005 to 0.098); a fitted 3x3 map M (f -> M f) leaves %.3g "
+        "(|M - I| = %.2f%s%s): the accelerometer's sign or axes (a flipped or swapped "
+        "column), the IMU's mounting (extrinsic rotation), a clock offset between IMU and "
+        "lidar (calibration: estimate_time_offset), or a diverged estimate",
+        r.identity_rms, r.windows, 2.0 * options_.half_window_s, options_.max_identity_rms,
+        r.free_rms, r.map_deviation, r.map_reading.empty() ? "" : ", true (x, y, z) = reading ",
+        r.map_reading.c_str());
     found = text;
   }
   const double deg = r.rotation_error.norm() * 180.0 / M_PI;

@@ -90,6 +90,8 @@ TEST(FrameConsistency, AFlippedOrSwappedAccelerometerIsNamed) {
             std::string::npos)
       << r.warning;
   EXPECT_NE(r.warning.find("true (x, y, z) = reading (-x, -y, -z)"), std::string::npos);
+  // A clock offset between IMU and lidar raises the same residual: it is named among the causes.
+  EXPECT_NE(r.warning.find("clock offset between IMU and lidar"), std::string::npos) << r.warning;
   // The gyro is fine: no rotation verdict.
   EXPECT_EQ(r.warning.find("gyro's rotations"), std::string::npos) << r.warning;
 
