@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ctlio/io/dataset.h"
+#include "ctlio/manifolds/types.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 
 namespace ctlio::testing {
@@ -51,5 +52,23 @@ class MutatedSource : public io::DataSource {
   sim::SimulatedSource source_;
   std::function<bool(io::ScanFrame*)> mutate_;
 };
+
+// `c` with every IMU sample's specific force passed through `mutate`.
+inline MutatedSource AccelMutatedSource(const sim::SimConfig& c,
+                                        std::function<Vec3(const Vec3&)> mutate) {
+  return MutatedSource(c, [mutate](io::ScanFrame* frame) {
+    for (io::ImuSample& s : frame->imu) s.accel = mutate(s.accel);
+    return true;
+  });
+}
+
+// The accelerometer faults the run checks are tested on, the clean reading first.
+inline std::vector<std::pair<std::string, std::function<Vec3(const Vec3&)>>> AccelerometerFaults() {
+  return {
+      {"clean", [](const Vec3& f) { return f; }},
+      {"sign flipped", [](const Vec3& f) { return Vec3(-f); }},
+      {"x and z swapped", [](const Vec3& f) { return Vec3(f.z(), f.y(), f.x()); }},
+  };
+}
 
 }  // namespace ctlio::testing

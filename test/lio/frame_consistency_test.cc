@@ -140,18 +140,11 @@ TEST(FrameConsistency, TooFewWindowsAreNotJudged) {
 testing::MutatedSource AccelMutated(std::function<Vec3(const Vec3&)> mutate) {
   sim::SimConfig c = testing::ShortMediumSequence();
   c.duration_s = 4.5;
-  return testing::MutatedSource(c, [mutate](io::ScanFrame* frame) {
-    for (io::ImuSample& s : frame->imu) s.accel = mutate(s.accel);
-    return true;
-  });
+  return testing::AccelMutatedSource(c, std::move(mutate));
 }
 
 TEST(FrameConsistency, SimulatedFlippedAndSwappedAccelerometersAreWarnedCleanIsNot) {
-  const std::vector<std::pair<std::string, std::function<Vec3(const Vec3&)>>> cases = {
-      {"clean", [](const Vec3& f) { return f; }},
-      {"sign flipped", [](const Vec3& f) { return Vec3(-f); }},
-      {"x and z swapped", [](const Vec3& f) { return Vec3(f.z(), f.y(), f.x()); }},
-  };
+  const auto cases = testing::AccelerometerFaults();
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
     double clean = 0.0;
     for (const auto& [name, mutate] : cases) {

@@ -87,25 +87,14 @@ TEST(ImuConsistency, TheMedianOverTheMovingScansIsJudged) {
   EXPECT_NE(c.warning.find("imu.gyro_variance"), std::string::npos) << c.warning;
 }
 
-// The simulated sequence with every IMU sample's specific force passed through `mutate`.
-testing::MutatedSource AccelMutatedSource(std::function<Vec3(const Vec3&)> mutate) {
-  return testing::MutatedSource(testing::ShortMediumSequence(), [mutate](io::ScanFrame* frame) {
-    for (ImuSample& s : frame->imu) s.accel = mutate(s.accel);
-    return true;
-  });
-}
-
 TEST(ImuConsistency, AFlippedAccelerometerIsWarnedAboutTheCleanRunIsNot) {
-  const std::vector<std::pair<std::string, std::function<Vec3(const Vec3&)>>> cases = {
-      {"clean", [](const Vec3& f) { return f; }},
-      {"sign flipped", [](const Vec3& f) { return Vec3(-f); }},
-      {"x and z swapped", [](const Vec3& f) { return Vec3(f.z(), f.y(), f.x()); }},
-  };
+  const auto cases = testing::AccelerometerFaults();
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
     double clean = 0.0;
     for (const auto& [name, mutate] : cases) {
       SCOPED_TRACE(name + " " + LioMethodName(m));
-      testing::MutatedSource source = AccelMutatedSource(mutate);
+      testing::MutatedSource source =
+          testing::AccelMutatedSource(testing::ShortMediumSequence(), mutate);
       const lioapp::RunSummary run =
           lioapp::RunOdometry(source, testing::SimLioConfig().ForMethod(m));
       std::printf("%s, %s: median accel chi2/dof %.3g, gyro %.3g over %d moving scans; ATE %.4f\n",
