@@ -90,6 +90,12 @@ def main(argv):
     bx.set_xlabel("ATE [cm], RMS over runs (log scale)")
     bx.legend(fontsize=8, loc="lower right")
     bx.grid(axis="x", color="#ddd")
+    # The headline a reader needs before the cells: how many, how many runs each, how many met.
+    runs = sorted({int(r["runs"]) for r in rows})
+    met = sum(int(r["target_met"]) for r in rows)
+    fig.suptitle(f"Singer-LIO vs baseline: {len(rows)} cells, "
+                 f"{'/'.join(map(str, runs))} runs per cell; target "
+                 f"(ATE and CPU no worse, no failure) met in {met} of {len(rows)}")
     fig.tight_layout()
     fig.savefig(argv[2], dpi=110)
 
