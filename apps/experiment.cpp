@@ -70,6 +70,10 @@ DEFINE_string(sim_sensor, "",
               "Sensor model os0_128 | os1_64 | os1_128 | vlp16 | hdl32e | pandar_xt32 | mid360 | "
               "avia (ctlio_simulate --sensor list; sets lidar, IMU and extrinsic; default config "
               "data/sensors/<sensor>.yaml)");
+DEFINE_string(sim_sensor_effects, "auto",
+              "The simulated lidar unit's effects (ctlio_simulate --sensor_effects): auto (the "
+              "preset's family; --sim_sensor's family in quad, town and office; none otherwise) | "
+              "off | ouster | hdl64 | velodyne | hesai | livox");
 DEFINE_string(
     sim_preset, "",
     "Recording preset: none | newer_college | kitti (sets world, regime, sensors, IMU, duration; "
@@ -128,7 +132,8 @@ using Job = lioapp::ExperimentJob;
 
 // The settings that must be equal for runs to be pooled, one "key value" per line.
 std::string SettingsText(const std::string& config_path, const std::string& preset,
-                         const std::string& world, const ctlio::sim::SimConfig& shared) {
+                         const std::string& world, const ctlio::sim::SimConfig& shared,
+                         const std::string& sensor_effects) {
   std::ostringstream s;
   s << "preset " << preset << "\nworld " << world << "\nduration_s " << shared.duration_s
     << "\nbeams " << shared.lidar.beams << "\nfiring_decimation " << shared.lidar.firing_decimation
@@ -141,6 +146,7 @@ std::string SettingsText(const std::string& config_path, const std::string& pres
   if (!FLAGS_sim_sensor.empty()) s << "sensor " << FLAGS_sim_sensor << "\n";
   if (!FLAGS_extrinsic_error.empty()) s << "extrinsic_error " << FLAGS_extrinsic_error << "\n";
   if (shared.lidar.rate_hz != 10.0) s << "lidar_rate_hz " << shared.lidar.rate_hz << "\n";
+  if (sensor_effects != "off") s << "sensor_effects " << sensor_effects << "\n";
   return s.str();
 }
 
@@ -245,6 +251,7 @@ int main(int argc, char** argv) {
     given.lidar_rate_hz = Given("lidar_rate", FLAGS_lidar_rate);
     given.body_centric = Given("body_centric", FLAGS_body_centric);
     if (!FLAGS_sim_sensor.empty()) given.sensor = FLAGS_sim_sensor;
+    if (FLAGS_sim_sensor_effects != "auto") given.sensor_effects = FLAGS_sim_sensor_effects;
     const std::string world_name = sim::WorldName(given.world.value_or(sim::PresetWorld(preset)));
     const auto regimes = SplitList(
         Given("regimes", FLAGS_regimes).value_or(sim::RegimeName(sim::PresetRegime(preset))));
@@ -378,8 +385,8 @@ int main(int argc, char** argv) {
       r.error = j.error;
       rows.push_back(r);
     }
-    const std::string settings =
-        SettingsText(config_path, sim::PresetName(preset), world_name, shared);
+    const std::string settings = SettingsText(config_path, sim::PresetName(preset), world_name,
+                                              shared, sim::PresetSensorEffects(preset, given));
     io::WriteTextFile(FLAGS_out + "/settings.txt", settings);
     written.Add(FLAGS_out + "/settings.txt", "the settings runs must share to be merged");
     lioapp::WriteResultsCsv(FLAGS_out + "/results.csv", rows);

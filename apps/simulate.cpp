@@ -79,8 +79,8 @@ DEFINE_double(beam_azimuth_error_deg, 0.0, "σ of fixed per-beam azimuth errors 
 DEFINE_string(sensor_effects, "auto",
               "The lidar unit's effects (sim sensor_effects.h: per-beam angle and range errors, "
               "footprint spread, mixed pixels, grazing dropouts): auto (the preset's or --sensor's "
-              "family under a preset, none otherwise) | off | ouster | hdl64 | velodyne | hesai | "
-              "livox");
+              "family under a preset; --sensor's family in quad, town and office; none "
+              "otherwise) | off | ouster | hdl64 | velodyne | hesai | livox");
 DEFINE_double(beam_range_offset_sigma, 0.0, "σ of fixed per-beam range offsets [m]");
 DEFINE_double(beam_divergence_mrad, 0.0,
               "Footprint depth spread r·δ·tan(incidence)/√12 added to the range noise [mrad]");

@@ -89,6 +89,32 @@ TEST(Presets, ExplicitSettingsOverrideThePreset) {
   EXPECT_DOUBLE_EQ(c.lidar.rate_hz, 10.0);
 }
 
+TEST(Presets, SensorModelsCarryTheirUnitEffectsOnlyInTheRealisticWorlds) {
+  SimOverrides o;
+  o.sensor = "vlp16";
+  o.world = WorldKind::kQuad;
+  EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "velodyne");
+  EXPECT_GT(PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.mixed_pixel_probability, 0.0);
+  o.world = WorldKind::kTown;
+  EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "velodyne");
+  // Table II's box and the older worlds stay ideal.
+  for (WorldKind w : {WorldKind::kBox, WorldKind::kStreet, WorldKind::kPark}) {
+    o.world = w;
+    EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "off");
+    EXPECT_EQ(PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.mixed_pixel_probability,
+              0.0);
+  }
+  // No sensor model: no unit to model, whatever the world; an explicit choice always wins.
+  SimOverrides bare;
+  bare.world = WorldKind::kOffice;
+  EXPECT_EQ(PresetSensorEffects(Preset::kNone, bare), "off");
+  bare.sensor_effects = "hesai";
+  EXPECT_EQ(PresetSensorEffects(Preset::kNone, bare), "hesai");
+  o.world = WorldKind::kQuad;
+  o.sensor_effects = "off";
+  EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "off");
+}
+
 TEST(Presets, LidarRateSetsTheScanRate) {
   SimOverrides o;
   o.lidar_rate_hz = 20.0;

@@ -101,6 +101,20 @@ void ApplyNewerCollegeSensors(SimConfig* config) {
   config->imu_from_lidar = io::NewerCollegeImuFromLidar();
 }
 
+std::string PresetSensorEffects(Preset preset, const SimOverrides& o) {
+  const std::string effects = o.sensor_effects.value_or("auto");
+  if (effects != "auto") return effects;
+  // A sensor model in one of the realistic worlds (quad, town, office: the worlds measured
+  // against real sweeps, docs/experiments/worlds-geometry.md) gets its unit's effects too; the
+  // older worlds and Table II's box stay ideal, bit for bit.
+  const WorldKind world = o.world.value_or(PresetWorld(preset));
+  const bool realistic =
+      world == WorldKind::kQuad || world == WorldKind::kTown || world == WorldKind::kOffice;
+  if (preset == Preset::kNone && !(o.sensor && realistic)) return "off";
+  if (o.sensor) return FindSensorModel(*o.sensor).effects_family;
+  return preset == Preset::kKitti ? "hdl64" : "ouster";
+}
+
 SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrides& o) {
   SimConfig c = ExperimentConfig(o.regime.value_or(PresetRegime(preset)), index, seed,
                                  o.world.value_or(PresetWorld(preset)));
@@ -117,13 +131,7 @@ SimConfig PresetConfig(Preset preset, int index, uint64_t seed, const SimOverrid
                                std::to_string(m.lidar.beams) + " beams are the datasheet's)");
     }
   }
-  std::string effects = o.sensor_effects.value_or("auto");
-  if (effects == "auto") {
-    effects = preset == Preset::kNone    ? "off"
-              : o.sensor                 ? FindSensorModel(*o.sensor).effects_family
-              : preset == Preset::kKitti ? "hdl64"
-                                         : "ouster";
-  }
+  const std::string effects = PresetSensorEffects(preset, o);
   if (effects != "off") {
     // One unit per experiment seed (never 0: 0 means "the noise seed" to the simulator).
     const uint64_t unit = (seed ^ 0x5E450C7EF1A3B2D9ULL) | 1ULL;

@@ -53,10 +53,14 @@ struct SimOverrides {
   // overrides apply on top of it (`beams` only to a sensor without a datasheet beam table).
   std::optional<std::string> sensor;
   // The unit's sensor effects (sensor_effects.h): "off", or a family (ouster, hdl64, ...); unset:
-  // the preset's (newer_college: ouster, kitti: hdl64, or the --sensor model's family), none
-  // without a preset.
+  // the preset's (newer_college: ouster, kitti: hdl64, or the --sensor model's family); without
+  // a preset, the sensor model's family in the realistic worlds (quad, town, office), else none.
   std::optional<std::string> sensor_effects;
 };
+
+// The sensor-effects family PresetConfig applies ("off" or a family), `overrides.sensor_effects`
+// resolved when unset or "auto" (see SimOverrides::sensor_effects).
+std::string PresetSensorEffects(Preset preset, const SimOverrides& overrides);
 
 // The preset's regime, world and duration (kNone: fast, box, 20 s: the Table II simulator).
 Regime PresetRegime(Preset preset);
