@@ -283,13 +283,14 @@ int main(int argc, char** argv) {
     set("lidar_dropout", FLAGS_lidar_dropout, &L.dropout);
     set("max_incidence_deg", FLAGS_max_incidence_deg, &L.max_incidence_deg);
     set("reflect_range", FLAGS_reflect_range, &L.reflect_range);
-    set("beam_elevation_error_deg", FLAGS_beam_elevation_error_deg, &L.elevation_error_deg);
-    set("beam_azimuth_error_deg", FLAGS_beam_azimuth_error_deg, &L.azimuth_error_deg);
-    set("beam_range_offset_sigma", FLAGS_beam_range_offset_sigma, &L.range_offset_sigma);
-    set("beam_divergence_mrad", 1e-3 * FLAGS_beam_divergence_mrad, &L.beam_divergence_rad);
-    set("mixed_pixels", FLAGS_mixed_pixels, &L.mixed_pixel_probability);
-    set("mixed_pixel_gap", FLAGS_mixed_pixel_gap, &L.mixed_pixel_min_gap);
-    set("grazing_dropout_start_deg", FLAGS_grazing_dropout_start_deg, &L.grazing_dropout_start_deg);
+    set("beam_elevation_error_deg", FLAGS_beam_elevation_error_deg, &L.effects.elevation_error_deg);
+    set("beam_azimuth_error_deg", FLAGS_beam_azimuth_error_deg, &L.effects.azimuth_error_deg);
+    set("beam_range_offset_sigma", FLAGS_beam_range_offset_sigma, &L.effects.range_offset_sigma);
+    set("beam_divergence_mrad", 1e-3 * FLAGS_beam_divergence_mrad, &L.effects.beam_divergence_rad);
+    set("mixed_pixels", FLAGS_mixed_pixels, &L.effects.mixed_pixel_probability);
+    set("mixed_pixel_gap", FLAGS_mixed_pixel_gap, &L.effects.mixed_pixel_min_gap);
+    set("grazing_dropout_start_deg", FLAGS_grazing_dropout_start_deg,
+        &L.effects.grazing_dropout_start_deg);
     auto& I = config.imu;
     I.accel_scale = ParseVec3("accel_scale", FLAGS_accel_scale);
     I.gyro_scale = ParseVec3("gyro_scale", FLAGS_gyro_scale);
@@ -357,16 +358,16 @@ int main(int argc, char** argv) {
          << ", range_noise_per_m: " << config.lidar.range_noise_per_m
          << ", lidar_dropout: " << L.dropout << ", max_incidence_deg: " << L.max_incidence_deg
          << ", reflect_range: " << L.reflect_range
-         << ", beam_elevation_error_deg: " << L.elevation_error_deg
-         << ", beam_azimuth_error_deg: " << L.azimuth_error_deg;
-    if (L.unit_seed != 0 || L.range_offset_sigma > 0 || L.beam_divergence_rad > 0 ||
-        L.mixed_pixel_probability > 0 || L.grazing_dropout_start_deg < 90) {
+         << ", beam_elevation_error_deg: " << L.effects.elevation_error_deg
+         << ", beam_azimuth_error_deg: " << L.effects.azimuth_error_deg;
+    if (L.unit_seed != 0 || L.effects.range_offset_sigma > 0 || L.effects.beam_divergence_rad > 0 ||
+        L.effects.mixed_pixel_probability > 0 || L.effects.grazing_dropout_start_deg < 90) {
       yaml << ", sensor_unit_seed: " << L.unit_seed
-           << ", beam_range_offset_sigma: " << L.range_offset_sigma
-           << ", beam_divergence_rad: " << L.beam_divergence_rad
-           << ", mixed_pixels: " << L.mixed_pixel_probability
-           << ", mixed_pixel_gap: " << L.mixed_pixel_min_gap
-           << ", grazing_dropout_start_deg: " << L.grazing_dropout_start_deg;
+           << ", beam_range_offset_sigma: " << L.effects.range_offset_sigma
+           << ", beam_divergence_rad: " << L.effects.beam_divergence_rad
+           << ", mixed_pixels: " << L.effects.mixed_pixel_probability
+           << ", mixed_pixel_gap: " << L.effects.mixed_pixel_min_gap
+           << ", grazing_dropout_start_deg: " << L.effects.grazing_dropout_start_deg;
     }
     yaml << ", accel_scale: [" << FLAGS_accel_scale << "], gyro_scale: [" << FLAGS_gyro_scale
          << "], accel_limit: " << FLAGS_accel_limit << ", gyro_limit: " << FLAGS_gyro_limit

@@ -94,15 +94,18 @@ TEST(Presets, SensorModelsCarryTheirUnitEffectsOnlyInTheRealisticWorlds) {
   o.sensor = "vlp16";
   o.world = WorldKind::kQuad;
   EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "velodyne");
-  EXPECT_GT(PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.mixed_pixel_probability, 0.0);
+  EXPECT_GT(
+      PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.effects.mixed_pixel_probability,
+      0.0);
   o.world = WorldKind::kTown;
   EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "velodyne");
   // Table II's box and the older worlds stay ideal.
   for (WorldKind w : {WorldKind::kBox, WorldKind::kStreet, WorldKind::kPark}) {
     o.world = w;
     EXPECT_EQ(PresetSensorEffects(Preset::kNone, o), "off");
-    EXPECT_EQ(PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.mixed_pixel_probability,
-              0.0);
+    EXPECT_EQ(
+        PresetConfig(Preset::kNone, 0, kExperimentSeed, o).lidar.effects.mixed_pixel_probability,
+        0.0);
   }
   // No sensor model: no unit to model, whatever the world; an explicit choice always wins.
   SimOverrides bare;

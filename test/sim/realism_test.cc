@@ -170,8 +170,8 @@ TEST(LidarRealism, RangeDependentNoiseIncidenceAndBeamErrors) {
   SimConfig e = Small(Regime::kMedium, 1);
   e.lidar.range_noise = 0.0;
   const LidarInertialSim nominal(e);
-  e.lidar.elevation_error_deg = 0.2;
-  e.lidar.azimuth_error_deg = 0.2;
+  e.lidar.effects.elevation_error_deg = 0.2;
+  e.lidar.effects.azimuth_error_deg = 0.2;
   const LidarInertialSim biased(e);
   const io::PointCloud p = nominal.Scan(2), q = biased.Scan(2);
   ASSERT_EQ(p.size(), q.size());

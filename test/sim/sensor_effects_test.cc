@@ -49,7 +49,7 @@ TEST(SensorEffects, RangeOffsetIsFixedPerBeamAndPerUnit) {
   SimConfig c = Quiet();
   const LidarInertialSim ideal(c);
   c.lidar.unit_seed = 7;
-  c.lidar.range_offset_sigma = 0.05;
+  c.lidar.effects.range_offset_sigma = 0.05;
   const LidarInertialSim unit(c);
   const io::PointCloud a = ideal.Scan(3), b = unit.Scan(3);
   ASSERT_EQ(a.size(), b.size());
@@ -69,7 +69,7 @@ TEST(SensorEffects, RangeOffsetIsFixedPerBeamAndPerUnit) {
   other.duration_s = 2.0;
   other.lidar = c.lidar;
   const LidarInertialSim same_unit(other);
-  other.lidar.range_offset_sigma = 0.0;
+  other.lidar.effects.range_offset_sigma = 0.0;
   const LidarInertialSim other_ideal(other);
   const io::PointCloud p = other_ideal.Scan(5), q = same_unit.Scan(5);
   ASSERT_EQ(p.size(), q.size());
@@ -85,8 +85,8 @@ TEST(SensorEffects, RangeOffsetIsFixedPerBeamAndPerUnit) {
 
 TEST(SensorEffects, BeamAngleErrorsBelongToTheUnitNotTheSequence) {
   SimConfig c = Quiet();
-  c.lidar.elevation_error_deg = 0.2;
-  c.lidar.azimuth_error_deg = 0.2;
+  c.lidar.effects.elevation_error_deg = 0.2;
+  c.lidar.effects.azimuth_error_deg = 0.2;
   SimConfig d = c;
   d.seed = c.seed + 1;  // another noise seed: IMU noise differs, the lidar has no noise
   // Without a unit seed the errors follow the noise seed (as before the unit effects)...
@@ -101,7 +101,7 @@ TEST(SensorEffects, BeamAngleErrorsBelongToTheUnitNotTheSequence) {
 TEST(SensorEffects, FootprintSpreadGrowsWithRangeAndIncidence) {
   SimConfig c = Quiet();
   const LidarInertialSim ideal(c);
-  c.lidar.beam_divergence_rad = 3e-3;
+  c.lidar.effects.beam_divergence_rad = 3e-3;
   const LidarInertialSim spread(c);
   // With no other noise the range error is n·r·δ·tanθ/√12, n ~ N(0, 1): normalised, σ = 1.
   double sq = 0.0;
@@ -130,8 +130,8 @@ TEST(SensorEffects, MixedPixelsLieBetweenTheTwoSurfacesOfAnEdge) {
   SimConfig c = Quiet(WorldKind::kStreet, Regime::kVehicle);
   c.lidar.firing_decimation = 4;
   const LidarInertialSim ideal(c);
-  c.lidar.mixed_pixel_probability = 1.0;
-  c.lidar.mixed_pixel_min_gap = 0.3;
+  c.lidar.effects.mixed_pixel_probability = 1.0;
+  c.lidar.effects.mixed_pixel_min_gap = 0.3;
   const LidarInertialSim mixed(c);
   const io::PointCloud a = ideal.Scan(6), b = mixed.Scan(6);
   const auto rays = ByRay(a);
@@ -155,7 +155,7 @@ TEST(SensorEffects, MixedPixelsLieBetweenTheTwoSurfacesOfAnEdge) {
   }
   EXPECT_GT(moved, 20);
   EXPECT_LT(moved, int(b.size()) / 4);  // edges, not surfaces
-  c.lidar.mixed_pixel_probability = 0.0;
+  c.lidar.effects.mixed_pixel_probability = 0.0;
   EXPECT_TRUE(SameScan(LidarInertialSim(c).Scan(6), a));
 }
 
@@ -163,7 +163,7 @@ TEST(SensorEffects, GrazingDropoutsFollowTheirRamp) {
   SimConfig c = Quiet();
   c.lidar.firing_decimation = 2;
   const LidarInertialSim ideal(c);
-  c.lidar.grazing_dropout_start_deg = 60.0;
+  c.lidar.effects.grazing_dropout_start_deg = 60.0;
   const LidarInertialSim grazing(c);
   double expected_lost = 0.0;
   size_t lost = 0, kept_steep = 0, all_steep = 0;
@@ -191,14 +191,14 @@ TEST(SensorEffects, OnlyWhereAskedFor) {
   // Without a preset (Table II's simulator) nothing; the presets carry their sensor's family.
   const SimConfig none = PresetConfig(Preset::kNone, 2);
   EXPECT_EQ(none.lidar.unit_seed, 0u);
-  EXPECT_EQ(none.lidar.beam_divergence_rad, 0.0);
-  EXPECT_EQ(none.lidar.mixed_pixel_probability, 0.0);
-  EXPECT_EQ(none.lidar.elevation_error_deg, 0.0);
+  EXPECT_EQ(none.lidar.effects.beam_divergence_rad, 0.0);
+  EXPECT_EQ(none.lidar.effects.mixed_pixel_probability, 0.0);
+  EXPECT_EQ(none.lidar.effects.elevation_error_deg, 0.0);
   const SimConfig nc = PresetConfig(Preset::kNewerCollege, 2);
-  EXPECT_EQ(nc.lidar.elevation_error_deg, SensorEffectsOf("ouster").elevation_error_deg);
-  EXPECT_GT(nc.lidar.beam_divergence_rad, 0.0);
+  EXPECT_EQ(nc.lidar.effects.elevation_error_deg, SensorEffectsOf("ouster").elevation_error_deg);
+  EXPECT_GT(nc.lidar.effects.beam_divergence_rad, 0.0);
   const SimConfig kitti = PresetConfig(Preset::kKitti, 2);
-  EXPECT_EQ(kitti.lidar.range_offset_sigma, SensorEffectsOf("hdl64").range_offset_sigma);
+  EXPECT_EQ(kitti.lidar.effects.range_offset_sigma, SensorEffectsOf("hdl64").range_offset_sigma);
   // One unit per experiment seed: every index shares it, another seed is another unit.
   EXPECT_EQ(PresetConfig(Preset::kKitti, 5).lidar.unit_seed, kitti.lidar.unit_seed);
   EXPECT_NE(PresetConfig(Preset::kKitti, 2, 11).lidar.unit_seed, kitti.lidar.unit_seed);
@@ -207,11 +207,12 @@ TEST(SensorEffects, OnlyWhereAskedFor) {
   off.sensor_effects = "off";
   const SimConfig plain = PresetConfig(Preset::kNewerCollege, 2, kExperimentSeed, off);
   EXPECT_EQ(plain.lidar.unit_seed, 0u);
-  EXPECT_EQ(plain.lidar.beam_divergence_rad, 0.0);
-  EXPECT_EQ(plain.lidar.grazing_dropout_start_deg, 90.0);
+  EXPECT_EQ(plain.lidar.effects.beam_divergence_rad, 0.0);
+  EXPECT_EQ(plain.lidar.effects.grazing_dropout_start_deg, 90.0);
   SimOverrides on;
   on.sensor_effects = "velodyne";
-  EXPECT_GT(PresetConfig(Preset::kNone, 2, kExperimentSeed, on).lidar.range_offset_sigma, 0.0);
+  EXPECT_GT(PresetConfig(Preset::kNone, 2, kExperimentSeed, on).lidar.effects.range_offset_sigma,
+            0.0);
   on.sensor_effects = "lidar";
   EXPECT_THROW(PresetConfig(Preset::kNone, 2, kExperimentSeed, on), std::runtime_error);
   LidarConfig L;
@@ -224,12 +225,12 @@ TEST(SensorEffects, InvalidValuesAreRejected) {
     edit(c.lidar);
     EXPECT_THROW(LidarInertialSim{c}, std::runtime_error);
   };
-  bad([](LidarConfig& L) { L.range_offset_sigma = -0.01; });
-  bad([](LidarConfig& L) { L.beam_divergence_rad = -1e-3; });
-  bad([](LidarConfig& L) { L.mixed_pixel_probability = 1.5; });
-  bad([](LidarConfig& L) { L.mixed_pixel_min_gap = -1.0; });
-  bad([](LidarConfig& L) { L.grazing_dropout_start_deg = 95.0; });
-  bad([](LidarConfig& L) { L.grazing_dropout_start_deg = std::nan(""); });
+  bad([](LidarConfig& L) { L.effects.range_offset_sigma = -0.01; });
+  bad([](LidarConfig& L) { L.effects.beam_divergence_rad = -1e-3; });
+  bad([](LidarConfig& L) { L.effects.mixed_pixel_probability = 1.5; });
+  bad([](LidarConfig& L) { L.effects.mixed_pixel_min_gap = -1.0; });
+  bad([](LidarConfig& L) { L.effects.grazing_dropout_start_deg = 95.0; });
+  bad([](LidarConfig& L) { L.effects.grazing_dropout_start_deg = std::nan(""); });
 }
 
 }  // namespace

@@ -27,10 +27,11 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   }
   const auto& I = config_.imu;
   if (L.dropout < 0 || L.dropout > 1 || L.max_incidence_deg <= 0 || L.max_incidence_deg > 90 ||
-      L.reflect_range < 0 || L.range_noise_per_m < 0 || L.elevation_error_deg < 0 ||
-      L.azimuth_error_deg < 0 || L.range_offset_sigma < 0 || L.beam_divergence_rad < 0 ||
-      L.mixed_pixel_probability < 0 || L.mixed_pixel_probability > 1 || L.mixed_pixel_min_gap < 0 ||
-      !(L.grazing_dropout_start_deg >= 0) || L.grazing_dropout_start_deg > 90 ||
+      L.reflect_range < 0 || L.range_noise_per_m < 0 || L.effects.elevation_error_deg < 0 ||
+      L.effects.azimuth_error_deg < 0 || L.effects.range_offset_sigma < 0 ||
+      L.effects.beam_divergence_rad < 0 || L.effects.mixed_pixel_probability < 0 ||
+      L.effects.mixed_pixel_probability > 1 || L.effects.mixed_pixel_min_gap < 0 ||
+      !(L.effects.grazing_dropout_start_deg >= 0) || L.effects.grazing_dropout_start_deg > 90 ||
       I.accel_limit < 0 || I.gyro_limit < 0 || I.outage_rate < 0 ||
       (I.outage_rate > 0 &&
        !(I.outage_length_min > 0 && I.outage_length_min <= I.outage_length_max))) {
@@ -73,21 +74,22 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
   // Beam and azimuth tables; fixed beam-angle errors from their own stream.
   // A unit's errors come from its own seed when given (every sequence of the unit shares them).
   const uint64_t unit_seed = L.unit_seed != 0 ? L.unit_seed : config_.seed;
-  if (L.elevation_error_deg > 0 || L.azimuth_error_deg > 0) {
+  if (L.effects.elevation_error_deg > 0 || L.effects.azimuth_error_deg > 0) {
     std::seed_seq beam_seq{uint32_t(unit_seed), uint32_t(unit_seed >> 32), 0xBEA4u};
     std::mt19937_64 beam_rng(beam_seq);
     std::normal_distribution<double> beam_normal;
     for (int b = 0; b < L.beams; ++b) {
-      beam_el_error_.push_back(L.elevation_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
-      beam_az_error_.push_back(L.azimuth_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
+      beam_el_error_.push_back(L.effects.elevation_error_deg * M_PI / 180.0 *
+                               beam_normal(beam_rng));
+      beam_az_error_.push_back(L.effects.azimuth_error_deg * M_PI / 180.0 * beam_normal(beam_rng));
     }
   }
-  if (L.range_offset_sigma > 0) {
+  if (L.effects.range_offset_sigma > 0) {
     std::seed_seq range_seq{uint32_t(unit_seed), uint32_t(unit_seed >> 32), 0x0FF5u};
     std::mt19937_64 range_rng(range_seq);
     std::normal_distribution<double> range_normal;
     for (int b = 0; b < L.beams; ++b) {
-      beam_range_offset_.push_back(L.range_offset_sigma * range_normal(range_rng));
+      beam_range_offset_.push_back(L.effects.range_offset_sigma * range_normal(range_rng));
     }
   }
   if (!L.elevations_deg.empty() && L.elevations_deg.size() != size_t(L.beams)) {
@@ -109,6 +111,23 @@ LidarInertialSim::LidarInertialSim(const SimConfig& config) : config_(config) {
     const double az = kTwoPi * f / L.firings_per_revolution;
     cos_az_.push_back(std::cos(az));
     sin_az_.push_back(std::sin(az));
+  }
+  if (!beam_el_error_.empty() && L.pattern.kind == PatternKind::kSpinning) {
+    // The same expressions as a ray's direction in Scan had them, so the values are the same.
+    for (int b = 0; b < L.beams; ++b) {
+      const double el = std::asin(sin_el_[b]) + beam_el_error_[b];
+      cos_el_ray_.push_back(std::cos(el));
+      sin_el_ray_.push_back(std::sin(el));
+    }
+    cos_az_ray_.assign(size_t(L.firings_per_revolution) * L.beams, 0.0);
+    sin_az_ray_.assign(cos_az_ray_.size(), 0.0);
+    for (int f = 0; f < L.firings_per_revolution; f += L.firing_decimation) {
+      for (int b = 0; b < L.beams; ++b) {
+        const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
+        cos_az_ray_[size_t(f) * L.beams + b] = std::cos(az);
+        sin_az_ray_[size_t(f) * L.beams + b] = std::sin(az);
+      }
+    }
   }
 }
 
@@ -271,11 +290,13 @@ double LidarInertialSim::CastRay(const Vec3& o, const Vec3& d) const {
 RayHit LidarInertialSim::Cast(const Vec3& o, const Vec3& d, double time) const {
   const auto& L = config_.lidar;
   const bool need_normal = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0 ||
-                           L.beam_divergence_rad > 0.0 || L.grazing_dropout_start_deg < 90.0;
+                           L.effects.beam_divergence_rad > 0.0 ||
+                           L.effects.grazing_dropout_start_deg < 90.0;
   if (config_.world.kind == WorldKind::kBox && !need_normal) return {CastRay(o, d), Vec3::Zero()};
   // Farther than this no noise draw brings a return back inside max_range.
-  const double reach = L.max_range * (1 + 6 * L.range_noise_per_m + 35 * L.beam_divergence_rad) +
-                       6 * L.range_noise + 4 * L.range_offset_sigma + 1.0;
+  const double reach =
+      L.max_range * (1 + 6 * L.range_noise_per_m + 35 * L.effects.beam_divergence_rad) +
+      6 * L.range_noise + 4 * L.effects.range_offset_sigma + 1.0;
   return world_.scene.Cast(o, d, reach, time);
 }
 
@@ -329,9 +350,9 @@ io::PointCloud LidarInertialSim::Scan(size_t k) const {
     *d_l = Vec3(cos_el_[b] * cos_az_[f], cos_el_[b] * sin_az_[f], sin_el_[b]);
     *d_ray = *d_l;
     if (beam_errors) {
-      const double el = std::asin(sin_el_[b]) + beam_el_error_[b];
-      const double az = kTwoPi * f / L.firings_per_revolution + beam_az_error_[b];
-      *d_ray = Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      const size_t i = size_t(f) * L.beams + b;
+      *d_ray =
+          Vec3(cos_el_ray_[b] * cos_az_ray_[i], cos_el_ray_[b] * sin_az_ray_[i], sin_el_ray_[b]);
     }
   });
 }
@@ -358,15 +379,17 @@ io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions
   const bool incidence = L.max_incidence_deg < 90.0 || L.reflect_range > 0.0;
   // The unit effects (sensor_effects.h) draw from a third stream, and only when configured, so
   // the other two streams and the output without them are unchanged bit for bit.
-  const bool footprint = L.beam_divergence_rad > 0.0, grazing = L.grazing_dropout_start_deg < 90.0;
-  const bool mixing = L.mixed_pixel_probability > 0.0;
+  const bool footprint = L.effects.beam_divergence_rad > 0.0,
+             grazing = L.effects.grazing_dropout_start_deg < 90.0;
+  const bool mixing = L.effects.mixed_pixel_probability > 0.0;
   std::seed_seq effect_seq{uint32_t(config_.seed), uint32_t(config_.seed >> 32), 0xEFFEu,
                            uint32_t(k)};
   std::mt19937_64 effect_rng(effect_seq);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   // True range of every beam's ray at the previous kept firing (mixed pixels' neighbours).
   std::vector<double> previous(mixing ? size_t(L.beams) : 0, kInf);
-  const double grazing_start = L.grazing_dropout_start_deg * M_PI / 180.0;
+  const double grazing_start = L.effects.grazing_dropout_start_deg * M_PI / 180.0;
+  const double grazing_cos_bound = std::cos(grazing_start) + 1e-9;
   // One pose per firing: all beams (lines) of a firing share its time.
   for (int f = 0; f < L.firings_per_revolution; f += L.firing_decimation) {
     const int64_t t_ns = FiringTimeNs(k, f);
@@ -390,8 +413,8 @@ io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions
         const double r_other = previous[b];
         previous[b] = r;
         if (std::isfinite(r) && std::isfinite(r_other) &&
-            std::abs(r_other - r) > L.mixed_pixel_min_gap &&
-            Uniform(effect_rng, 0, 1) < L.mixed_pixel_probability) {
+            std::abs(r_other - r) > L.effects.mixed_pixel_min_gap &&
+            Uniform(effect_rng, 0, 1) < L.effects.mixed_pixel_probability) {
           r += Uniform(effect_rng, 0, 1) * (r_other - r);
         }
       }
@@ -404,9 +427,10 @@ io::PointCloud LidarInertialSim::ScanRays(size_t k, const Directions& directions
           // Uniform depth spread r·δ·tanθ over the footprint (LidarConfig), σ = spread/√12.
           const double tan_i =
               std::min(std::sqrt(std::max(1.0 - cos_i * cos_i, 0.0)) / cos_i, 20.0);
-          m += n * r * L.beam_divergence_rad * tan_i / std::sqrt(12.0);
+          m += n * r * L.effects.beam_divergence_rad * tan_i / std::sqrt(12.0);
         }
-        if (grazing) {
+        // acos only near grazing: cos_i above cos(start) by a margin is surely below the start.
+        if (grazing && cos_i < grazing_cos_bound) {
           const double theta = std::acos(std::min(cos_i, 1.0));
           if (theta > grazing_start &&
               Uniform(effect_rng, 0, 1) < (theta - grazing_start) / (0.5 * M_PI - grazing_start)) {

@@ -40,13 +40,7 @@ SensorEffects SensorEffectsOf(const std::string& family) {
 void ApplySensorEffects(const SensorEffects& e, uint64_t unit_seed, LidarConfig* L) {
   if (unit_seed == 0) throw std::runtime_error("ApplySensorEffects: unit seed must be non-zero");
   L->unit_seed = unit_seed;
-  L->elevation_error_deg = e.elevation_error_deg;
-  L->azimuth_error_deg = e.azimuth_error_deg;
-  L->range_offset_sigma = e.range_offset_sigma;
-  L->beam_divergence_rad = e.beam_divergence_rad;
-  L->mixed_pixel_probability = e.mixed_pixel_probability;
-  L->mixed_pixel_min_gap = e.mixed_pixel_min_gap;
-  L->grazing_dropout_start_deg = e.grazing_dropout_start_deg;
+  L->effects = e;
 }
 
 }  // namespace ctlio::sim

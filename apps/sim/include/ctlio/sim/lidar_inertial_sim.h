@@ -78,6 +78,28 @@ struct MotionProfile {
 // speed / 2.5 m/s² long.
 MotionProfile DrawMotion(Regime regime, int index, uint64_t seed = kExperimentSeed);
 
+// Effects of a real lidar unit (sensor_effects.h: the families' values; defaults off).
+struct SensorEffects {
+  // Fixed per-beam angle errors (σ, degrees): the ray leaves at the true angles, the point is
+  // reported along the nominal ones (an uncalibrated sensor).
+  double elevation_error_deg = 0.0;
+  double azimuth_error_deg = 0.0;
+  double range_offset_sigma = 0.0;  // σ of a fixed per-beam range offset [m] (calibration)
+  // Footprint spread: a beam of divergence δ lights a spot r·δ wide; on a surface at incidence θ
+  // its depths span r·δ·tanθ, a uniform spread of σ = r·δ·tanθ/√12 added to σ(r) (tanθ ≤ 20).
+  double beam_divergence_rad = 0.0;
+  // Mixed pixels: where the true range jumps by more than `mixed_pixel_min_gap` [m] between this
+  // ray and its neighbour along the ring (the previous kept firing of the beam), the footprint
+  // straddles both surfaces and, with this probability, the return lies between them:
+  // r + u·(r_neighbour − r), u ~ U(0, 1).
+  double mixed_pixel_probability = 0.0;
+  double mixed_pixel_min_gap = 0.5;
+  // Grazing dropouts: a return is lost with probability (θ − start)/(90° − start) for incidence
+  // θ > start [deg] (weak, spread-out echoes); 90 = off.
+  double grazing_dropout_start_deg = 90.0;
+  bool Any() const;
+};
+
 struct LidarConfig {
   int beams = 128;
   double min_elevation_deg = -25.0;
@@ -95,27 +117,11 @@ struct LidarConfig {
   // Weak echoes: received power ∝ cos θ / r², so a return needs r ≤ reflect_range·√cos θ
   // (θ = incidence angle); 0 = off.
   double reflect_range = 0.0;
-  // Fixed per-beam angle errors (σ, degrees): the ray leaves at the true angles, the point is
-  // reported along the nominal ones (an uncalibrated sensor).
-  double elevation_error_deg = 0.0;
-  double azimuth_error_deg = 0.0;
   // Effects of a real sensor unit (sensor_effects.h; defaults off). `unit_seed` draws the fixed
-  // per-unit errors (the beam-angle errors above and the range offsets below) so that every
-  // sequence recorded with one unit shares them; 0: from SimConfig::seed, as before.
+  // per-unit errors (the beam-angle errors and range offsets of `effects`) so that every sequence
+  // recorded with one unit shares them; 0: from SimConfig::seed, as before.
   uint64_t unit_seed = 0;
-  double range_offset_sigma = 0.0;  // σ of a fixed per-beam range offset [m] (calibration)
-  // Footprint spread: a beam of divergence δ lights a spot r·δ wide; on a surface at incidence θ
-  // its depths span r·δ·tanθ, a uniform spread of σ = r·δ·tanθ/√12 added to σ(r) (tanθ ≤ 20).
-  double beam_divergence_rad = 0.0;
-  // Mixed pixels: where the true range jumps by more than `mixed_pixel_min_gap` [m] between this
-  // ray and its neighbour along the ring (the previous kept firing of the beam), the footprint
-  // straddles both surfaces and, with this probability, the return lies between them:
-  // r + u·(r_neighbour − r), u ~ U(0, 1).
-  double mixed_pixel_probability = 0.0;
-  double mixed_pixel_min_gap = 0.5;
-  // Grazing dropouts: a return is lost with probability (θ − start)/(90° − start) for incidence
-  // θ > start [deg] (weak, spread-out echoes); 90 = off.
-  double grazing_dropout_start_deg = 90.0;
+  SensorEffects effects;
   // A datasheet's per-beam elevations [deg], one per beam in ring order; empty: `beams` evenly
   // spaced over [min, max]_elevation_deg (sensor_models.h).
   std::vector<double> elevations_deg;
@@ -246,6 +252,9 @@ class LidarInertialSim {
   std::vector<std::vector<Vec6>> biases_;              // per IMU
   std::vector<io::ImuSample> all_imu_;
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
+  // With beam-angle errors: where the rays really go, per beam (elevation) and per kept firing
+  // × beam (azimuth, index f·beams + b), computed once instead of five trigonometric calls a ray.
+  std::vector<double> cos_el_ray_, sin_el_ray_, cos_az_ray_, sin_az_ray_;
   SE3 MagnusStep(const SE3& T, double t, double h) const;
   // The body-rate motion P (SPEC §6 sinusoids) and its pose integrated on the grid.
   Vec6 LocalTwist(double t) const;

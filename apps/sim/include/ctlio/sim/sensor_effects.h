@@ -20,24 +20,15 @@
 
 namespace ctlio::sim {
 
-struct SensorEffects {
-  double elevation_error_deg = 0.0;  // σ of the fixed per-beam elevation error
-  double azimuth_error_deg = 0.0;    // σ of the fixed per-beam azimuth error
-  double range_offset_sigma = 0.0;   // σ of the fixed per-beam range offset [m]
-  double beam_divergence_rad = 0.0;  // footprint depth spread
-  double mixed_pixel_probability = 0.0;
-  double mixed_pixel_min_gap = 0.5;         // [m]
-  double grazing_dropout_start_deg = 90.0;  // 90 = off
-  bool Any() const;
-};
+// SensorEffects: lidar_inertial_sim.h (a part of LidarConfig).
 
 // The effects of a sensor family: "ouster" (OS0/OS1), "hdl64" (KITTI's HDL-64E), "velodyne"
 // (VLP-16, HDL-32E), "hesai" (Pandar XT-32), "livox" (no beams: footprint, mixed pixels and
 // grazing dropouts only). Throws std::runtime_error naming the families otherwise.
 SensorEffects SensorEffectsOf(const std::string& family);
 
-// The effects applied to `lidar` (replacing its values of the same options), the unit's fixed
-// errors drawn from `unit_seed` (non-zero; the same unit in every sequence that passes it).
+// The effects applied to `lidar` (replacing its `effects`), the unit's fixed errors drawn from
+// `unit_seed` (non-zero; the same unit in every sequence that passes it).
 void ApplySensorEffects(const SensorEffects& effects, uint64_t unit_seed, LidarConfig* lidar);
 
 }  // namespace ctlio::sim
