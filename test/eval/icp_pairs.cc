@@ -7,19 +7,25 @@
 //   icp_pairs sim <preset> <world> <world_seed> <index> <first scan> <gap> <pairs> [deskew]
 // With `deskew` the simulated sweeps are first motion-corrected with the ground truth into the
 // lidar frame at the middle of the sweep (as the real Newer College sweeps and features are).
+// Environment: ICP_NO_EFFECTS=1 (the preset without its sensor effects), ICP_EFFECT_ONLY=angles|
+// range|footprint|mixed|grazing (one effect alone), ICP_FEATURES=1 (LOAM-like features of each
+// sweep instead of all its points, as the real Newer College pairs are).
 //
 //   icp_pairs seq <preset> <world> <world_seed> <index> <first scan> <scans> <window> [nodeskew]
 // runs the point-to-point odometry (point_odometry.h: constant-velocity prediction and deskew,
 // local voxel map) over raw simulated sweeps, started at the true pose of the first, and prints
 // the drift (final error over the path length) and the relative error over every `window`
 // consecutive sweeps (the spacing of the real keyframe pairs), as a % of the distance. It starts
-// with the true motion of the first two sweeps. Environment (experiments): ICP_GATES=g (gates g,
-// g/2 instead of 2, 1, 0.5 m), ICP_NO_EFFECTS=1 (the preset without its sensor effects).
+// with the true motion of the first two sweeps. Environment (experiments): ICP_FIXED_SIGMA=s (a
+// fixed threshold σ instead of the adaptive one), ICP_NO_EFFECTS=1 (the preset without its sensor
+// effects).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -41,6 +47,30 @@ std::vector<Vec3> ReadSweep(const std::string& spec) {
     out.insert(out.end(), c.points.begin(), c.points.end());
   }
   return out;
+}
+
+// LOAM-like features of a sweep, to compare with the real Newer College features (planes ≈ 31 %,
+// edges ≈ 2 % of an OS1-64 sweep's points): along each ring in firing order, the curvature
+// |Σ_{j=−5..5} (p_{i+j} − p_i)| / |p_i|; per ring the flattest 31 % as planes and the sharpest 2 %
+// as edges. Returns the indices kept.
+std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c) {
+  std::map<int, std::vector<size_t>> rings;
+  for (size_t i = 0; i < c.size(); ++i) rings[c.ring.empty() ? 0 : c.ring[i]].push_back(i);
+  std::vector<size_t> keep;
+  for (const auto& [ring, idx] : rings) {
+    std::vector<std::pair<double, size_t>> curv;
+    for (size_t k = 5; k + 5 < idx.size(); ++k) {
+      Vec3 d = Vec3::Zero();
+      for (int j = -5; j <= 5; ++j) d += c.points[idx[k + j]] - c.points[idx[k]];
+      curv.push_back({d.norm() / c.points[idx[k]].norm(), idx[k]});
+    }
+    std::sort(curv.begin(), curv.end());
+    const size_t planes = size_t(0.31 * curv.size()), edges = size_t(0.02 * curv.size());
+    for (size_t k = 0; k < planes; ++k) keep.push_back(curv[k].second);
+    for (size_t k = curv.size() - edges; k < curv.size(); ++k) keep.push_back(curv[k].second);
+  }
+  std::sort(keep.begin(), keep.end());
+  return keep;
 }
 
 double total_t = 0.0, total_r = 0.0, total_d = 0.0;
@@ -84,7 +114,33 @@ int main(int argc, char** argv) {
       }
     } else if (mode == "sim" && (argc == 9 || (argc == 10 && std::string(argv[9]) == "deskew"))) {
       const bool deskew = argc == 10;
-      sim::SimConfig c = sim::PresetConfig(sim::ParsePreset(argv[2]), std::stoi(argv[5]));
+      sim::SimOverrides overrides;
+      if (std::getenv("ICP_NO_EFFECTS")) overrides.sensor_effects = "off";
+      sim::SimConfig c = sim::PresetConfig(sim::ParsePreset(argv[2]), std::stoi(argv[5]),
+                                           sim::kExperimentSeed, overrides);
+      if (const char* only = std::getenv("ICP_EFFECT_ONLY")) {
+        // One of the preset's effects alone (the others off).
+        const sim::SensorEffects e = c.lidar.effects;
+        sim::SensorEffects& f = c.lidar.effects;
+        f = sim::SensorEffects();
+        const std::string o = only;
+        if (o == "angles") {
+          f.elevation_error_deg = e.elevation_error_deg;
+          f.azimuth_error_deg = e.azimuth_error_deg;
+        } else if (o == "range") {
+          f.range_offset_sigma = e.range_offset_sigma;
+        } else if (o == "footprint") {
+          f.beam_divergence_rad = e.beam_divergence_rad;
+        } else if (o == "mixed") {
+          f.mixed_pixel_probability = e.mixed_pixel_probability;
+          f.mixed_pixel_min_gap = e.mixed_pixel_min_gap;
+        } else if (o == "grazing") {
+          f.grazing_dropout_start_deg = e.grazing_dropout_start_deg;
+        } else {
+          throw std::invalid_argument("ICP_EFFECT_ONLY: angles|range|footprint|mixed|grazing");
+        }
+      }
+      const bool features = std::getenv("ICP_FEATURES") != nullptr;
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
       const int first = std::stoi(argv[6]), gap = std::stoi(argv[7]), n = std::stoi(argv[8]);
@@ -101,7 +157,10 @@ int main(int argc, char** argv) {
             c.points[i] = mid_inv * (sim.WorldFromLidar(sim.Seconds(c.times_ns[i])) * c.points[i]);
           }
         }
-        return c.points;
+        if (!features) return c.points;
+        std::vector<Vec3> kept;
+        for (const size_t i : LoamLikeFeatures(c)) kept.push_back(c.points[i]);
+        return kept;
       };
       for (int j = 0; j < n; ++j) {
         const int a = first + j * gap, b = a + gap;
@@ -115,6 +174,14 @@ int main(int argc, char** argv) {
                                            sim::kExperimentSeed, overrides);
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
+      if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
+        // The guided motion's fast rotations (pitch, roll, fast yaw) scaled, to ask how much of
+        // the drift they cause.
+        sim::GuideProfile& g = c.motion.guide;
+        g.pitch.amplitude *= std::atof(m);
+        g.roll.amplitude *= std::atof(m);
+        g.yaw_fast.amplitude *= std::atof(m);
+      }
       const int first = std::stoi(argv[6]), n = std::stoi(argv[7]), window = std::stoi(argv[8]);
       c.duration_s = 0.1 * (first + n + 2);
       c.integration_step_s = 1e-3;
@@ -123,11 +190,27 @@ int main(int argc, char** argv) {
       auto mid = [&](int k) { return sim.Seconds(sim.ScanStartNs(k)) + 0.5 * period; };
       std::vector<SE3> truth;
       for (int k = first; k < first + n; ++k) truth.push_back(sim.WorldFromLidar(mid(k)));
+      // The constant-velocity model's error on the truth itself: δ(D) of point_odometry.h for
+      // D = (T_{k−1}·Δ_{k−1})⁻¹·T_k, as the RMS over the sequence (the σ an exact registration
+      // would give the adaptive threshold, min_motion aside).
+      double model_sse = 0.0;
+      for (int k = 2; k < n; ++k) {
+        const SE3 D = (truth[k - 1] * (truth[k - 2].Inverse() * truth[k - 1])).Inverse() * truth[k];
+        const double d = D.translation().norm() + 2.0 * std::min(100.0, c.lidar.max_range) *
+                                                      std::sin(0.5 * D.Log().tail<3>().norm());
+        model_sse += d * d;
+      }
+      std::printf("truth's constant-velocity model error (RMS): %.3f m\n",
+                  std::sqrt(model_sse / std::max(1, n - 2)));
+      if (std::getenv("ICP_TRUTH_ONLY")) return 0;
       eval::PointOdometryOptions options;
       options.deskew = argc == 9;
       options.max_range = std::min(100.0, c.lidar.max_range);
-      if (const char* g = std::getenv("ICP_GATES"))
-        options.gates = {std::atof(g), 0.5 * std::atof(g)};
+      if (const char* s = std::getenv("ICP_FIXED_SIGMA")) options.fixed_sigma = std::atof(s);
+      if (const char* s = std::getenv("ICP_MAP_VOXEL")) {
+        options.map_voxel = std::atof(s);
+        options.source_voxel = 1.5 * options.map_voxel;
+      }
       // Started in motion: the true relative motion of the first two sweeps as the initial
       // constant velocity (the odometry cannot know it from one sweep).
       eval::PointOdometry odometry(truth.front(), options, truth[0].Inverse() * truth[1]);
@@ -138,10 +221,25 @@ int main(int argc, char** argv) {
         for (size_t i = 0; i < cloud.size(); ++i)
           times[i] = sim.Seconds(cloud.times_ns[i]) - mid(k);
         const std::clock_t c0 = std::clock();
-        odometry.Register(cloud.points, times, period);
+        const SE3 est = odometry.Register(cloud.points, times, period);
         cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
+        if (std::getenv("ICP_VERBOSE")) {
+          // Relative to the previous sweep, in the truth's lidar frame.
+          const int j = k - first;
+          const std::vector<SE3>& e = odometry.poses();
+          const SE3 d =
+              j == 0 ? SE3()
+                     : (truth[j - 1].Inverse() * truth[j]).Inverse() * (e[j - 1].Inverse() * e[j]);
+          const Vec3 r = d.Log().tail<3>() * 180.0 / M_PI;
+          std::printf(
+              "sweep %d: error %.3f m, sigma %.3f m; step error %+.3f %+.3f %+.3f m "
+              "%+.3f %+.3f %+.3f deg\n",
+              k, (est.translation() - truth[j].translation()).norm(), odometry.sigmas().back(),
+              d.translation().x(), d.translation().y(), d.translation().z(), r.x(), r.y(), r.z());
+        }
       }
       const std::vector<SE3>& est = odometry.poses();
+
       double path = 0.0;
       for (int k = 1; k < n; ++k)
         path += (truth[k].translation() - truth[k - 1].translation()).norm();

@@ -12,8 +12,11 @@ namespace ctlio::eval {
 namespace {
 
 // Sweeps of a room (floor, two walls, boxes) seen from a sensor moving with the body twist `xi`
-// per sweep: each point is measured at its own time τ ∈ [−½, ½) sweep, from T(k + τ).
-std::vector<SE3> RunRoom(bool deskew, double* final_error) {
+// per sweep: each point is measured at its own time τ ∈ [−½, ½) sweep, from T(k + τ). From sweep
+// `jump_at` on the sensor also slides by `jump` m per sweep along x and y (a prediction error).
+std::vector<SE3> RunRoom(bool deskew, double* final_error, PointOdometryOptions options = {},
+                         int jump_at = 1000, double jump = 0.0,
+                         std::vector<double>* sigmas = nullptr) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Vec3> world;
@@ -27,10 +30,12 @@ std::vector<SE3> RunRoom(bool deskew, double* final_error) {
   }
   Vec6 xi;
   xi << 0.8, 0.05, 0.0, 0.0, 0.0, 0.08;  // per sweep: 8 m/s and 0.8 rad/s at 10 Hz
-  auto pose = [&](double s) { return SE3::Exp(s * xi); };
-  PointOdometryOptions options;
+  auto pose = [&](double s) {
+    const double slide = s > jump_at ? jump * (s - jump_at) : 0.0;
+    return SE3(Mat3::Identity(), Vec3(slide, slide, 0)) * SE3::Exp(s * xi);
+  };
   options.deskew = deskew;
-  PointOdometry odometry(pose(0), options);
+  PointOdometry odometry(pose(0), options, SE3::Exp(xi));  // started in motion
   for (int k = 0; k < 12; ++k) {
     std::vector<Vec3> points;
     std::vector<double> times;
@@ -45,7 +50,26 @@ std::vector<SE3> RunRoom(bool deskew, double* final_error) {
     odometry.Register(points, times, 0.1);
   }
   *final_error = (odometry.poses().back().translation() - pose(11).translation()).norm();
+  if (sigmas != nullptr) *sigmas = odometry.sigmas();
   return odometry.poses();
+}
+
+TEST(AdaptiveThreshold, RootMeanSquareOfThePredictionErrorsAboveTheMinimumMotion) {
+  AdaptiveThreshold t(2.0, 0.1, 100.0);
+  EXPECT_EQ(t.Sigma(), 2.0);
+  // Below the minimum motion: not counted, σ stays.
+  EXPECT_NEAR(t.Update(SE3(Mat3::Identity(), Vec3(0.05, 0, 0))), 0.05, 1e-12);
+  EXPECT_EQ(t.Sigma(), 2.0);
+  EXPECT_EQ(t.samples(), 0);
+  t.Update(SE3(Mat3::Identity(), Vec3(0, 0.3, 0)));
+  EXPECT_NEAR(t.Sigma(), 0.3, 1e-12);
+  // A rotation of θ moves a point at the largest range by 2·r_max·sin(θ/2).
+  Vec6 rot;
+  rot << 0, 0, 0, 0, 0, 0.01;
+  const double d = 2.0 * 100.0 * std::sin(0.005);
+  EXPECT_NEAR(t.Update(SE3::Exp(rot)), d, 1e-9);
+  EXPECT_NEAR(t.Sigma(), std::sqrt((0.09 + d * d) / 2.0), 1e-9);
+  EXPECT_EQ(t.samples(), 2);
 }
 
 TEST(PointOdometry, FollowsAConstantVelocityMotion) {
@@ -57,6 +81,26 @@ TEST(PointOdometry, FollowsAConstantVelocityMotion) {
   // comes out close without deskewing too, but not the same.
   EXPECT_LT(without, 0.1);
   EXPECT_GT(std::abs(without - with), 1e-4);
+}
+
+// A slide of 0.4 m per sweep along x and y from sweep 6 on: the constant-velocity prediction is
+// 0.57 m off there, every wall farther than the gate. The adaptive threshold, still at its initial
+// σ (the smooth sweeps before moved the prediction by less than min_motion), finds the
+// correspondences and then learns σ of the order of the error; a fixed σ of 0.05 m (gate
+// 0.15 m) keeps only the floor, which says nothing about x and y.
+TEST(PointOdometry, AdaptiveThresholdFollowsASuddenChangeOfMotion) {
+  double adaptive = 0.0, fixed = 0.0;
+  std::vector<double> sigmas;
+  RunRoom(true, &adaptive, {}, 6, 0.4, &sigmas);
+  EXPECT_LT(adaptive, 0.05);
+  ASSERT_EQ(sigmas.size(), 12u);
+  EXPECT_EQ(sigmas[6], 2.0);
+  EXPECT_GT(sigmas[8], 0.1);
+  EXPECT_LT(sigmas[8], 1.0);
+  PointOdometryOptions tight;
+  tight.fixed_sigma = 0.05;
+  RunRoom(true, &fixed, tight, 6, 0.4);
+  EXPECT_GT(fixed, 0.2);
 }
 
 TEST(PointOdometry, RejectsMismatchedInput) {

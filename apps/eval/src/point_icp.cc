@@ -45,7 +45,7 @@ PointIcpResult RegisterPointToPoint(const std::vector<Vec3>& source,
         tree.Nearest(p, 1, &nn, &d2);
         if (nn.empty() || d2[0] > gate * gate) continue;
         const Vec3 e = p - tree.points()[nn[0]];
-        const double k = o.kernel * gate * gate;
+        const double k = o.kernel_absolute > 0.0 ? o.kernel_absolute : o.kernel * gate * gate;
         const double w = k * k / ((k + e.squaredNorm()) * (k + e.squaredNorm()));
         Eigen::Matrix<double, 3, 6> J;
         J << Mat3::Identity(), -so3::Hat(p);

@@ -1,17 +1,25 @@
 #include "ctlio/eval/point_odometry.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 #include <unordered_set>
+
+#include "ctlio/manifolds/so3.h"
 
 namespace ctlio::eval {
 namespace {
 
-uint64_t VoxelKey(const Vec3& p, double voxel) {
-  const auto key = [&](int i) { return uint64_t(int64_t(std::floor(p[i] / voxel)) & 0x1FFFFF); };
-  return key(0) | key(1) << 21 | key(2) << 42;
+std::array<int64_t, 3> VoxelOf(const Vec3& p, double voxel) {
+  return {int64_t(std::floor(p.x() / voxel)), int64_t(std::floor(p.y() / voxel)),
+          int64_t(std::floor(p.z() / voxel))};
+}
+
+uint64_t Key(const std::array<int64_t, 3>& v) {
+  return (uint64_t(v[0]) & 0x1FFFFF) | (uint64_t(v[1]) & 0x1FFFFF) << 21 |
+         (uint64_t(v[2]) & 0x1FFFFF) << 42;
 }
 
 // One original point per voxel, the first (as KISS-ICP keeps).
@@ -19,21 +27,98 @@ std::vector<Vec3> FirstPerVoxel(const std::vector<Vec3>& points, double voxel) {
   std::unordered_set<uint64_t> seen;
   std::vector<Vec3> out;
   for (const Vec3& p : points) {
-    if (seen.insert(VoxelKey(p, voxel)).second) out.push_back(p);
+    if (seen.insert(Key(VoxelOf(p, voxel))).second) out.push_back(p);
   }
   return out;
 }
 
 }  // namespace
 
+double AdaptiveThreshold::Update(const SE3& deviation) {
+  const double theta = deviation.Log().tail<3>().norm();
+  const double delta = deviation.translation().norm() + 2.0 * max_range_ * std::sin(0.5 * theta);
+  if (delta > min_motion_) {
+    sum_squares_ += delta * delta;
+    ++samples_;
+  }
+  return delta;
+}
+
+double AdaptiveThreshold::Sigma() const {
+  return samples_ == 0 ? initial_ : std::sqrt(sum_squares_ / samples_);
+}
+
 PointOdometry::PointOdometry(const SE3& first, const PointOdometryOptions& options,
                              const SE3& motion)
-    : options_(options), first_(first), motion_(motion) {}
+    : options_(options),
+      first_(first),
+      motion_(motion),
+      threshold_(options.initial_sigma, options.min_motion, options.max_range) {}
 
 size_t PointOdometry::MapSize() const {
   size_t n = 0;
-  for (const auto& [key, v] : map_) n += v.points.size();
+  for (const Voxel& v : map_) n += v.points.size();
   return n;
+}
+
+const Vec3* PointOdometry::Nearest(const Vec3& p, double max_distance) const {
+  // KISS-ICP's search: the 3 × 3 × 3 map voxels around p's, so a correspondence is never
+  // farther than two voxels whatever the threshold.
+  const std::array<int64_t, 3> c = VoxelOf(p, options_.map_voxel);
+  const Vec3* best = nullptr;
+  double best_d2 = max_distance * max_distance;
+  for (int64_t dx = -1; dx <= 1; ++dx) {
+    for (int64_t dy = -1; dy <= 1; ++dy) {
+      for (int64_t dz = -1; dz <= 1; ++dz) {
+        const auto it = index_.find(Key({c[0] + dx, c[1] + dy, c[2] + dz}));
+        if (it == index_.end()) continue;
+        for (const Vec3& q : map_[it->second].points) {
+          const double d2 = (q - p).squaredNorm();
+          if (d2 < best_d2) {
+            best_d2 = d2;
+            best = &q;
+          }
+        }
+      }
+    }
+  }
+  return best;
+}
+
+SE3 PointOdometry::Align(const std::vector<Vec3>& source, const SE3& previous, const SE3& initial,
+                         double sigma) const {
+  // Unknown T = T_{k−1}⁻¹·T_k (the sweep in the previous sweep's frame), perturbed on the left,
+  // T ← Exp(δ)·T: with world coordinates of a hundred metres a perturbation about the world
+  // origin would couple rotation and translation badly. For q = T·s the world point is
+  // p = T_{k−1}·q, e = p − m (m its map neighbour), ∂e/∂δ = R_{k−1}·[I, −q^].
+  const double gate = 3.0 * sigma, kernel = sigma / 3.0;
+  const Mat3 R = previous.rotation();
+  SE3 T = initial;
+  for (int it = 0; it < options_.iterations; ++it) {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Vec6 g = Vec6::Zero();
+    int used = 0;
+    for (const Vec3& s : source) {
+      const Vec3 q = T * s;
+      const Vec3 p = previous * q;
+      const Vec3* m = Nearest(p, gate);
+      if (m == nullptr) continue;
+      const Vec3 e = p - *m;
+      // Geman–McClure as KISS-ICP writes it (point_icp.h): w = κ² / (κ + |e|²)².
+      const double w = kernel * kernel / ((kernel + e.squaredNorm()) * (kernel + e.squaredNorm()));
+      Eigen::Matrix<double, 3, 6> J;
+      J << R, -R * so3::Hat(q);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * e;
+      ++used;
+    }
+    if (used < 6) break;
+    const Vec6 delta = -H.ldlt().solve(g);
+    if (!delta.allFinite()) break;
+    T = SE3::Exp(delta) * T;
+    if (delta.norm() < options_.converged) break;
+  }
+  return T;
 }
 
 SE3 PointOdometry::Register(const std::vector<Vec3>& points, const std::vector<double>& times,
@@ -54,24 +139,17 @@ SE3 PointOdometry::Register(const std::vector<Vec3>& points, const std::vector<d
   }
   const std::vector<Vec3> frame = FirstPerVoxel(deskewed, 0.5 * options_.map_voxel);
   SE3 pose = first_;
+  double sigma = 0.0;
   if (k > 0) {
-    // Registered in the previous sweep's frame: with world coordinates of a hundred metres the
-    // rotation and translation of the left perturbation couple badly (point_icp.h).
-    const SE3 previous_inv = poses_[k - 1].Inverse();
-    std::vector<Vec3> target;
-    target.reserve(MapSize());
-    for (const auto& [key, v] : map_) {
-      for (const Vec3& p : v.points) target.push_back(previous_inv * p);
-    }
-    PointIcpOptions icp;
-    icp.source_voxel = 0.0;  // downsampled here
-    icp.gates = options_.gates;
-    icp.damping = options_.damping;
-    pose = poses_[k - 1] *
-           RegisterPointToPoint(FirstPerVoxel(frame, options_.source_voxel), target, delta, icp)
-               .target_from_source;
+    sigma = options_.fixed_sigma > 0.0 ? options_.fixed_sigma : threshold_.Sigma();
+    const SE3 relative =
+        Align(FirstPerVoxel(frame, options_.source_voxel), poses_[k - 1], delta, sigma);
+    // The prediction's error, D = (T_{k−1}·Δ)⁻¹·T_k = Δ⁻¹·relative.
+    threshold_.Update(delta.Inverse() * relative);
+    pose = poses_[k - 1] * relative;
   }
   poses_.push_back(pose);
+  sigmas_.push_back(sigma);
   std::vector<Vec3> world;
   world.reserve(frame.size());
   for (const Vec3& p : frame) world.push_back(pose * p);
@@ -80,25 +158,27 @@ SE3 PointOdometry::Register(const std::vector<Vec3>& points, const std::vector<d
 }
 
 void PointOdometry::AddToMap(const std::vector<Vec3>& world_points, const Vec3& sensor) {
-  std::unordered_map<uint64_t, size_t> index;
-  for (size_t i = 0; i < map_.size(); ++i) index[map_[i].first] = i;
   for (const Vec3& p : world_points) {
-    const uint64_t key = VoxelKey(p, options_.map_voxel);
-    const auto it = index.find(key);
-    if (it == index.end()) {
-      index[key] = map_.size();
-      map_.push_back({key, Voxel{{p}}});
-    } else if (int(map_[it->second].second.points.size()) < options_.max_points_per_voxel) {
-      map_[it->second].second.points.push_back(p);
+    const uint64_t key = Key(VoxelOf(p, options_.map_voxel));
+    const auto it = index_.find(key);
+    if (it == index_.end()) {
+      index_[key] = map_.size();
+      map_.push_back(Voxel{key, {p}});
+    } else if (int(map_[it->second].points.size()) < options_.max_points_per_voxel) {
+      map_[it->second].points.push_back(p);
     }
   }
   // Forget what is out of reach (the first point of a voxel stands for it).
   const double r2 = options_.map_radius * options_.map_radius;
-  map_.erase(std::remove_if(map_.begin(), map_.end(),
-                            [&](const auto& kv) {
-                              return (kv.second.points.front() - sensor).squaredNorm() > r2;
-                            }),
+  const size_t before = map_.size();
+  map_.erase(std::remove_if(
+                 map_.begin(), map_.end(),
+                 [&](const Voxel& v) { return (v.points.front() - sensor).squaredNorm() > r2; }),
              map_.end());
+  if (map_.size() != before) {
+    index_.clear();
+    for (size_t i = 0; i < map_.size(); ++i) index_[map_[i].key] = i;
+  }
 }
 
 }  // namespace ctlio::eval

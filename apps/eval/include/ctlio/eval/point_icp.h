@@ -4,6 +4,7 @@
 // original point per voxel, nearest neighbours
 // within a shrinking gate, and Gauss–Newton on SE(3) with Geman–McClure weights
 //   w_i = κ² / (κ + |e_i|²)²,  e_i = T·s_i − t_i,
+// (ρ(e) = ½e²/(κ + e²) as KISS-ICP writes it, κ in m² numerically),
 // with the left perturbation T ← Exp(δ)·T, ∂e_i/∂δ = [I, −(T·s_i)^].
 #pragma once
 
@@ -18,7 +19,9 @@ struct PointIcpOptions {
   double target_voxel = 0.0;                    // 0: every target point
   std::vector<double> gates = {2.0, 1.0, 0.5};  // correspondence distance per stage [m]
   int iterations = 40;                          // per stage, at most
-  double kernel = 0.1;      // κ of the Geman–McClure weight, as a fraction of the stage's gate²
+  double kernel = 0.1;  // κ of the Geman–McClure weight, as a fraction of the stage's gate²
+  // κ itself when > 0 (KISS-ICP: σ/3 of its adaptive threshold), instead of kernel·gate².
+  double kernel_absolute = 0.0;
   double converged = 1e-5;  // |δ| below which a stage ends
   // Levenberg damping: (H + μ·diag(H))·δ = −g; 0 = Gauss–Newton. Keeps a step along a direction
   // the correspondences hardly constrain (a road between walls, a lawn) from running off.
