@@ -9,7 +9,8 @@
 // lidar frame at the middle of the sweep (as the real Newer College sweeps and features are).
 // Environment: ICP_NO_EFFECTS=1 (the preset without its sensor effects), ICP_EFFECT_ONLY=angles|
 // range|footprint|mixed|grazing (one effect alone), ICP_FEATURES=1 (LOAM-like features of each
-// sweep instead of all its points, as the real Newer College pairs are).
+// sweep instead of all its points, as the real Newer College pairs are), ICP_EFFECT_DROP=a,b (the
+// preset's effects without these).
 //
 //   icp_pairs seq <preset> <world> <world_seed> <index> <first scan> <scans> <window> [nodeskew]
 // runs the point-to-point odometry (point_odometry.h: constant-velocity prediction and deskew,
@@ -18,7 +19,9 @@
 // consecutive sweeps (the spacing of the real keyframe pairs), as a % of the distance. It starts
 // with the true motion of the first two sweeps. Environment (experiments): ICP_FIXED_SIGMA=s (a
 // fixed threshold σ instead of the adaptive one), ICP_NO_EFFECTS=1 (the preset without its sensor
-// effects).
+// effects), ICP_TRUE_DESKEW=1 (sweeps deskewed with the truth), ICP_MAP_VOXEL=v (map voxel v,
+// registration points 1.5·v), ICP_SHAKE_SCALE=s (the walk's or drive's fast rotations × s),
+// ICP_TRUTH_ONLY=1 (only the truth's constant-velocity model error), ICP_VERBOSE=1 (per sweep).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -140,6 +143,16 @@ int main(int argc, char** argv) {
           throw std::invalid_argument("ICP_EFFECT_ONLY: angles|range|footprint|mixed|grazing");
         }
       }
+      if (const char* drop = std::getenv("ICP_EFFECT_DROP")) {
+        // The preset's effects without these (comma-separated, names as ICP_EFFECT_ONLY).
+        sim::SensorEffects& f = c.lidar.effects;
+        const std::string d = drop;
+        if (d.find("angles") != std::string::npos) f.elevation_error_deg = f.azimuth_error_deg = 0;
+        if (d.find("range") != std::string::npos) f.range_offset_sigma = 0;
+        if (d.find("footprint") != std::string::npos) f.beam_divergence_rad = 0;
+        if (d.find("mixed") != std::string::npos) f.mixed_pixel_probability = 0;
+        if (d.find("grazing") != std::string::npos) f.grazing_dropout_start_deg = 90;
+      }
       const bool features = std::getenv("ICP_FEATURES") != nullptr;
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
@@ -207,6 +220,8 @@ int main(int argc, char** argv) {
       options.deskew = argc == 9;
       options.max_range = std::min(100.0, c.lidar.max_range);
       if (const char* s = std::getenv("ICP_FIXED_SIGMA")) options.fixed_sigma = std::atof(s);
+      const bool true_deskew = std::getenv("ICP_TRUE_DESKEW") != nullptr;
+      if (true_deskew) options.deskew = false;
       if (const char* s = std::getenv("ICP_MAP_VOXEL")) {
         options.map_voxel = std::atof(s);
         options.source_voxel = 1.5 * options.map_voxel;
@@ -216,10 +231,18 @@ int main(int argc, char** argv) {
       eval::PointOdometry odometry(truth.front(), options, truth[0].Inverse() * truth[1]);
       double cpu = 0.0;
       for (int k = first; k < first + n; ++k) {
-        const io::PointCloud cloud = sim.Scan(k);
+        io::PointCloud cloud = sim.Scan(k);
         std::vector<double> times(cloud.size());
         for (size_t i = 0; i < cloud.size(); ++i)
           times[i] = sim.Seconds(cloud.times_ns[i]) - mid(k);
+        if (true_deskew) {
+          // Deskewed with the truth (the odometry's own deskew off): its registration alone.
+          const SE3 mid_inv = sim.WorldFromLidar(mid(k)).Inverse();
+          for (size_t i = 0; i < cloud.size(); ++i) {
+            cloud.points[i] =
+                mid_inv * (sim.WorldFromLidar(sim.Seconds(cloud.times_ns[i])) * cloud.points[i]);
+          }
+        }
         const std::clock_t c0 = std::clock();
         const SE3 est = odometry.Register(cloud.points, times, period);
         cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
@@ -231,22 +254,33 @@ int main(int argc, char** argv) {
               j == 0 ? SE3()
                      : (truth[j - 1].Inverse() * truth[j]).Inverse() * (e[j - 1].Inverse() * e[j]);
           const Vec3 r = d.Log().tail<3>() * 180.0 / M_PI;
+          const Vec3 step =
+              j == 0 ? Vec3::Zero() : (truth[j - 1].Inverse() * truth[j]).translation();
+          std::printf("sweep %d: true step %+.2f %+.2f %+.2f m; ", k, step.x(), step.y(), step.z());
           std::printf(
-              "sweep %d: error %.3f m, sigma %.3f m; step error %+.3f %+.3f %+.3f m "
+              "error %.3f m, sigma %.3f m; step error %+.3f %+.3f %+.3f m "
               "%+.3f %+.3f %+.3f deg\n",
-              k, (est.translation() - truth[j].translation()).norm(), odometry.sigmas().back(),
+              (est.translation() - truth[j].translation()).norm(), odometry.sigmas().back(),
               d.translation().x(), d.translation().y(), d.translation().z(), r.x(), r.y(), r.z());
         }
       }
       const std::vector<SE3>& est = odometry.poses();
 
+      // Tracked: the sweeps before the first one more than 1 m off the truth (the figures below
+      // are over those; a run that never leaves has tracked = n).
+      int tracked = 0;
+      while (tracked < n && est[tracked].translation().allFinite() &&
+             (est[tracked].translation() - truth[tracked].translation()).norm() < 1.0) {
+        ++tracked;
+      }
+      const int m = std::max(tracked, 1);
       double path = 0.0;
-      for (int k = 1; k < n; ++k)
+      for (int k = 1; k < m; ++k)
         path += (truth[k].translation() - truth[k - 1].translation()).norm();
-      const double final_error = (est.back().translation() - truth.back().translation()).norm();
+      const double final_error = (est[m - 1].translation() - truth[m - 1].translation()).norm();
       double rel_t = 0.0, rel_r = 0.0, rel_d = 0.0;
       int windows = 0;
-      for (int k = 0; k + window < n; ++k) {
+      for (int k = 0; k + window < m; ++k) {
         const SE3 dt = truth[k].Inverse() * truth[k + window];
         const SE3 e = dt.Inverse() * (est[k].Inverse() * est[k + window]);
         rel_t += e.translation().norm();
@@ -254,14 +288,17 @@ int main(int argc, char** argv) {
         rel_d += dt.translation().norm();
         ++windows;
       }
+      double sigma_sum = 0.0;
+      for (int k = 1; k < m; ++k) sigma_sum += odometry.sigmas()[k];
       std::printf(
-          "%s %s seed %s index %s sweeps %d-%d%s: path %.1f m, final error %.3f m (%.2f %%); "
-          "over %d windows of %d sweeps (mean %.2f m): %.3f m (%.2f %%), %.3f deg; %.0f ms CPU "
-          "per sweep\n",
+          "%s %s seed %s index %s sweeps %d-%d%s: tracked %d of %d sweeps (error < 1 m); over "
+          "them: path %.1f m, error at the end %.3f m (%.2f %%); over %d windows of %d sweeps "
+          "(mean %.2f m): %.3f m (%.2f %%), %.3f deg; mean sigma %.2f m; %.0f ms CPU per sweep\n",
           argv[2], argv[3], argv[4], argv[5], first, first + n - 1,
-          options.deskew ? "" : " (no deskew)", path, final_error, 100.0 * final_error / path,
-          windows, window, rel_d / windows, rel_t / windows, 100.0 * rel_t / rel_d, rel_r / windows,
-          1e3 * cpu / n);
+          options.deskew ? "" : " (no deskew)", tracked, n, path, final_error,
+          100.0 * final_error / std::max(path, 1e-9), windows, window, rel_d / std::max(windows, 1),
+          rel_t / std::max(windows, 1), 100.0 * rel_t / std::max(rel_d, 1e-9),
+          rel_r / std::max(windows, 1), sigma_sum / std::max(m - 1, 1), 1e3 * cpu / n);
       return 0;
     } else {
       std::cerr << "usage: icp_pairs real <graph.txt> <sweep>... | icp_pairs sim <preset> <world> "
