@@ -21,7 +21,8 @@
 // fixed threshold σ instead of the adaptive one), ICP_NO_EFFECTS=1 (the preset without its sensor
 // effects), ICP_TRUE_DESKEW=1 (sweeps deskewed with the truth), ICP_MAP_VOXEL=v (map voxel v,
 // registration points 1.5·v), ICP_SHAKE_SCALE=s (the walk's or drive's fast rotations × s),
-// ICP_TRUTH_ONLY=1 (only the truth's constant-velocity model error), ICP_VERBOSE=1 (per sweep).
+// ICP_TRUTH_ONLY=1 (only the truth's constant-velocity model error), ICP_VERBOSE=1 (per sweep),
+// ICP_NO_NOISE=1 (no range noise).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -198,6 +199,7 @@ int main(int argc, char** argv) {
       const int first = std::stoi(argv[6]), n = std::stoi(argv[7]), window = std::stoi(argv[8]);
       c.duration_s = 0.1 * (first + n + 2);
       c.integration_step_s = 1e-3;
+      if (std::getenv("ICP_NO_NOISE")) c.lidar.range_noise = 0.0;  // with ICP_NO_EFFECTS: ideal
       const sim::LidarInertialSim sim(c);
       const double period = 1.0 / c.lidar.rate_hz;
       auto mid = [&](int k) { return sim.Seconds(sim.ScanStartNs(k)) + 0.5 * period; };
