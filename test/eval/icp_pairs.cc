@@ -22,7 +22,7 @@
 // effects), ICP_TRUE_DESKEW=1 (sweeps deskewed with the truth), ICP_MAP_VOXEL=v (map voxel v,
 // registration points 1.5·v), ICP_SHAKE_SCALE=s (the walk's or drive's fast rotations × s),
 // ICP_TRUTH_ONLY=1 (only the truth's constant-velocity model error), ICP_VERBOSE=1 (per sweep),
-// ICP_NO_NOISE=1 (no range noise).
+// ICP_NO_NOISE=1 (no range noise), ICP_MIN_RANGE=r (points nearer than r [m] dropped; 1 m).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -222,6 +222,7 @@ int main(int argc, char** argv) {
       options.deskew = argc == 9;
       options.max_range = std::min(100.0, c.lidar.max_range);
       if (const char* s = std::getenv("ICP_FIXED_SIGMA")) options.fixed_sigma = std::atof(s);
+      if (const char* s = std::getenv("ICP_MIN_RANGE")) options.min_range = std::atof(s);
       const bool true_deskew = std::getenv("ICP_TRUE_DESKEW") != nullptr;
       if (true_deskew) options.deskew = false;
       if (const char* s = std::getenv("ICP_MAP_VOXEL")) {
