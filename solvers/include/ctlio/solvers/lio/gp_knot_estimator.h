@@ -99,6 +99,9 @@ class GpKnotEstimator final : public Estimator {
   size_t ScanStartIndex() const;
   const Knot& ScanStart() const { return knots_[ScanStartIndex()]; }
   SE3 PoseSinceScanStart(double tau) const;
+  // The sweep's knot count: window.knots_per_scan, or more when window.adaptive_knots_* find
+  // the motion of its IMU samples too curved for fewer (knot_spacing.h).
+  int KnotsForScan(double t_prev, double t_end) const;
   // One knot at t after the newest, with the motion prior, bias walk and IMU measurements of the
   // interval between them.
   void AddKnotAndFactors(double t, SlidingWindow* window, ScanResult* result);
