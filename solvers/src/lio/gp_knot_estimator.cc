@@ -251,6 +251,7 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
   }
   const double t_prev = knots_.back().t;
   const int K = KnotsForScan(t_prev, scan.t_end);
+  split_sweep_ = K > config_.knots_per_scan;
   for (int i = 1; i <= K; ++i) {
     const double t = i == K ? scan.t_end : t_prev + (scan.t_end - t_prev) * i / K;
     AddKnotAndFactors(t, window, result);

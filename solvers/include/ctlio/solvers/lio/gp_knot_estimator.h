@@ -130,7 +130,8 @@ class GpKnotEstimator final : public Estimator {
   std::deque<Knot> knots_;                   // oldest first
   double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
-  int scan_knots_ = 0;  // knots the last AddState added (0 after Initialise)
+  int scan_knots_ = 0;        // knots the last AddState added (0 after Initialise)
+  bool split_sweep_ = false;  // the last AddState's sweep got more knots than knots_per_scan
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)

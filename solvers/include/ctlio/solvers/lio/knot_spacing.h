@@ -25,6 +25,13 @@ struct AdaptiveKnotOptions {
   double gyro_curvature = 0.0;
   // Threshold on the accelerometer residual about its line over the sweep [m/s²]; 0: not used.
   double accel_curvature = 0.0;
+  // On a sweep the rule gives more knots than knots_per_scan, the IMU measurement variances are
+  // at least these (accelerometer [(m/s²)²], gyro [(rad/s)²]; 0: the configured ones): there the
+  // whitened IMU error is dominated by what the GP mean between knots cannot follow of a motion
+  // curved at 4–8 Hz, not by the device noise a sensor file's variances were set from
+  // (docs/experiments/knot-spacing.md).
+  double accel_variance_floor = 0.0;
+  double gyro_variance_floor = 0.0;
 
   bool enabled(int knots_per_scan) const {
     return max_knots_per_scan > knots_per_scan && (gyro_curvature > 0.0 || accel_curvature > 0.0);

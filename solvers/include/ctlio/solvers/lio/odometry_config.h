@@ -122,6 +122,8 @@ struct OdometryConfig {
   // line in time gets the fewest K ≤ adaptive_knots_max knots with r / K² ≤ threshold, so the
   // knot spacing follows the motion (handheld shaking) rather than the sensor. Off by default in
   // code (max ≤ knots_per_scan); data/sensors/base.yaml sets it (docs/experiments/knot-spacing.md).
+  // window.adaptive_knots_accel_variance, _gyro_variance: the IMU variances' floor on the sweeps
+  // the rule splits (AdaptiveKnotOptions).
   AdaptiveKnotOptions adaptive_knots;
   // window.threads: the solve's interpolations and lidar rows (SlidingWindowOptions::threads);
   // Ceres evaluates on one thread (iterations per round: lidar_frontend.solver_iterations)
