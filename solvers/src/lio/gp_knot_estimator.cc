@@ -19,6 +19,7 @@
 #include "ctlio/solvers/lio/calibration_blocks.h"
 #include "ctlio/solvers/lio/continuous_lidar_term.h"
 #include "ctlio/solvers/lio/imu_knot_prediction.h"
+#include "ctlio/solvers/lio/knot_spacing.h"
 
 namespace ctlio::lio {
 
@@ -248,13 +249,30 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
       history_.pop_front();
     }
   }
-  const int K = config_.knots_per_scan;
   const double t_prev = knots_.back().t;
+  const int K = KnotsForScan(t_prev, scan.t_end);
+  split_sweep_ = K > config_.knots_per_scan;
   for (int i = 1; i <= K; ++i) {
     const double t = i == K ? scan.t_end : t_prev + (scan.t_end - t_prev) * i / K;
     AddKnotAndFactors(t, window, result);
   }
   scan_knots_ = K;
+}
+
+int GpKnotEstimator::KnotsForScan(double t_prev, double t_end) const {
+  const int fixed = config_.knots_per_scan;
+  if (!uses_imu() || !config_.adaptive_knots.enabled(fixed)) return fixed;
+  // The first IMU's samples of the sweep, by their stamps: a clock offset of a few ms shifts the
+  // window the motion is judged on, not the judgement (knot_spacing.h).
+  const std::vector<ImuSample> samples = imu_.Samples(t_prev, t_end, 0);
+  std::vector<double> t;
+  std::vector<Vec3> gyro, accel;
+  for (const ImuSample& s : samples) {
+    t.push_back(imu_.Seconds(s.t_ns) - t_prev);
+    gyro.push_back(s.gyro);
+    accel.push_back(s.accel);
+  }
+  return KnotsForSweep(config_.adaptive_knots, fixed, t, gyro, accel);
 }
 
 void GpKnotEstimator::AddKnotAndFactors(double t, SlidingWindow* window, ScanResult* result) {

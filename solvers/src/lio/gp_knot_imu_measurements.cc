@@ -3,6 +3,7 @@
 // one block per interval (ImuIntervalBatch, the default) or one block per sample.
 #include <ceres/loss_function.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -18,8 +19,16 @@ namespace ctlio::lio {
 void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int imu_index,
                                          const std::vector<ImuSample>& imu, SlidingWindow* window,
                                          ScanResult* result) {
-  const Mat3 gyro_cov = config_.GyroVariance(imu_index) * Mat3::Identity();
-  const Mat3 accel_cov = config_.AccelVariance(imu_index) * Mat3::Identity();
+  // On a sweep the motion rule split, at least its variance floors (knot_spacing.h).
+  const AdaptiveKnotOptions& adaptive = config_.adaptive_knots;
+  const double gyro_variance =
+      split_sweep_ ? std::max(config_.GyroVariance(imu_index), adaptive.gyro_variance_floor)
+                   : config_.GyroVariance(imu_index);
+  const double accel_variance =
+      split_sweep_ ? std::max(config_.AccelVariance(imu_index), adaptive.accel_variance_floor)
+                   : config_.AccelVariance(imu_index);
+  const Mat3 gyro_cov = gyro_variance * Mat3::Identity();
+  const Mat3 accel_cov = accel_variance * Mat3::Identity();
   const imu::ImuMounting& mounting = mountings_[imu_index];
   const imu::AccelModel accel_model = config_.exact_specific_force ? imu::AccelModel::kSpecificForce
                                                                    : imu::AccelModel::kBodyCentric;

@@ -154,6 +154,17 @@ void OdometryConfig::Validate() const {
   require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
           "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
+  require(adaptive_knots.max_knots_per_scan >= 1 && adaptive_knots.max_knots_per_scan <= 10,
+          "window.adaptive_knots_max must be in [1, 10]");
+  require(adaptive_knots.gyro_curvature >= 0 && std::isfinite(adaptive_knots.gyro_curvature),
+          "window.adaptive_knots_gyro_curvature must be finite and >= 0 (0: not used)");
+  require(adaptive_knots.accel_curvature >= 0 && std::isfinite(adaptive_knots.accel_curvature),
+          "window.adaptive_knots_accel_curvature must be finite and >= 0 (0: not used)");
+  require(adaptive_knots.accel_variance_floor >= 0 &&
+              std::isfinite(adaptive_knots.accel_variance_floor) &&
+              adaptive_knots.gyro_variance_floor >= 0 &&
+              std::isfinite(adaptive_knots.gyro_variance_floor),
+          "window.adaptive_knots_accel_variance and _gyro_variance must be finite and >= 0");
   require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
   for (const ImuSensor& s : imus) {
     require(s.accel_variance >= 0 && s.gyro_variance >= 0, "imus[].variances must be >= 0");
@@ -251,6 +262,11 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
           v, section, source,
           {{"knots", SetInRange(&c->window_knots, 2, kMaxWindowKnots, source, section + ".knots")},
            {"knots_per_scan", SetFromYaml(&c->knots_per_scan)},
+           {"adaptive_knots_max", SetFromYaml(&c->adaptive_knots.max_knots_per_scan)},
+           {"adaptive_knots_gyro_curvature", SetFromYaml(&c->adaptive_knots.gyro_curvature)},
+           {"adaptive_knots_accel_curvature", SetFromYaml(&c->adaptive_knots.accel_curvature)},
+           {"adaptive_knots_accel_variance", SetFromYaml(&c->adaptive_knots.accel_variance_floor)},
+           {"adaptive_knots_gyro_variance", SetFromYaml(&c->adaptive_knots.gyro_variance_floor)},
            {"threads",
             SetInRange(&c->solver_threads, 1, kMaxConfigThreads, source, section + ".threads")},
            {"overlap", SetFromYaml(&c->overlap_stages)},

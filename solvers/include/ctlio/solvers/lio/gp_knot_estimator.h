@@ -99,6 +99,9 @@ class GpKnotEstimator final : public Estimator {
   size_t ScanStartIndex() const;
   const Knot& ScanStart() const { return knots_[ScanStartIndex()]; }
   SE3 PoseSinceScanStart(double tau) const;
+  // The sweep's knot count: window.knots_per_scan, or more when window.adaptive_knots_* find
+  // the motion of its IMU samples too curved for fewer (knot_spacing.h).
+  int KnotsForScan(double t_prev, double t_end) const;
   // One knot at t after the newest, with the motion prior, bias walk and IMU measurements of the
   // interval between them.
   void AddKnotAndFactors(double t, SlidingWindow* window, ScanResult* result);
@@ -127,7 +130,8 @@ class GpKnotEstimator final : public Estimator {
   std::deque<Knot> knots_;                   // oldest first
   double* extrinsic_ = nullptr;              // T_rl (kExtrinsicKey) when estimated
   int64_t next_knot_ = 0;
-  int scan_knots_ = 0;  // knots the last AddState added (0 after Initialise)
+  int scan_knots_ = 0;        // knots the last AddState added (0 after Initialise)
+  bool split_sweep_ = false;  // the last AddState's sweep got more knots than knots_per_scan
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)

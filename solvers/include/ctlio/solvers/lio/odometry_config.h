@@ -20,6 +20,7 @@
 #include "ctlio/solvers/lio/calibration_options.h"
 #include "ctlio/solvers/lio/degeneracy.h"
 #include "ctlio/solvers/lio/input_check_options.h"
+#include "ctlio/solvers/lio/knot_spacing.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
 
 namespace YAML {
@@ -115,6 +116,15 @@ struct OdometryConfig {
   // motion prior and bias walk go to the interval that holds their time; after the scan the
   // window marginalises down to window_knots − 1 knots as before. 1 = the paper's knot per scan.
   int knots_per_scan = 1;
+  // window.adaptive_knots_max, window.adaptive_knots_gyro_curvature [rad/s],
+  // window.adaptive_knots_accel_curvature [m/s²] (the GP methods; knot_spacing.h): a sweep whose
+  // gyro (accelerometer) samples leave an RMS residual r above the threshold about their straight
+  // line in time gets the fewest K ≤ adaptive_knots_max knots with r / K² ≤ threshold, so the
+  // knot spacing follows the motion (handheld shaking) rather than the sensor. Off by default in
+  // code (max ≤ knots_per_scan); data/sensors/base.yaml sets it (docs/experiments/knot-spacing.md).
+  // window.adaptive_knots_accel_variance, _gyro_variance: the IMU variances' floor on the sweeps
+  // the rule splits (AdaptiveKnotOptions).
+  AdaptiveKnotOptions adaptive_knots;
   // window.threads: the solve's interpolations and lidar rows (SlidingWindowOptions::threads);
   // Ceres evaluates on one thread (iterations per round: lidar_frontend.solver_iterations)
   int solver_threads = 1;
