@@ -187,6 +187,30 @@ TEST(Ros2BadInput, PerPointTimesThatCannotBeASweepAreRescaledAndOutliersDropped)
     // The rescaled sweep spans most of a period again (not 1/1000 of it).
     EXPECT_GT(frames[1].end_ns - frames[1].start_ns, 50'000'000);
   }
+  // 't' holding the ring number, and every point at the stamp: times from the azimuth.
+  for (const std::string defect : {"ring_as_t", "all_at_stamp"}) {
+    SCOPED_TRACE(defect);
+    bag = SmallBag();
+    EditCloud(&bag, 2, [&](sensor_msgs::PointCloud2* m) {
+      const auto& t = Field(*m, "t");
+      const auto& ring = Field(*m, "ring");
+      const bool u8 = ring.datatype == sensor_msgs::PointField::UINT8;
+      ASSERT_TRUE(u8 || ring.datatype == sensor_msgs::PointField::UINT16);
+      for (size_t i = 0; i + m->point_step <= m->data.size(); i += m->point_step) {
+        uint16_t r = 0;
+        std::memcpy(&r, m->data.data() + i + ring.offset, u8 ? 1 : 2);
+        const uint32_t v = defect == "ring_as_t" ? r : 0;
+        std::memcpy(m->data.data() + i + t.offset, &v, 4);
+      }
+    });
+    WarningSink sink;
+    std::unique_ptr<BagSource> s;
+    const auto frames = ReadEverything(bag, &s);
+    EXPECT_EQ(s->retimed_scans(), 1u);
+    EXPECT_TRUE(sink.Has(std::string("mem: topic ") + kPoints + ", message 2: time field"));
+    EXPECT_TRUE(sink.Has("from the azimuth"));
+    EXPECT_GT(frames[1].end_ns - frames[1].start_ns, 50'000'000);
+  }
   // Five points three seconds after the stamp: dropped and counted, the scan not stretched.
   bag = SmallBag();
   EditCloud(&bag, 3, [](sensor_msgs::PointCloud2* m) {
