@@ -38,7 +38,8 @@ WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
                  "points_dropped_out_of_interval", "scans_skipped", "constant_imu_scans",
                  "lidar_gaps", "overlapping_scans")
 WARN_KEYS = ("first_input_warning", "extrinsic_disagreement", "no_ate", "first_lidar_gap",
-             "input_defect", "config_warning", "imu_inconsistency", "frame_inconsistency")
+             "input_defect", "config_warning", "imu_inconsistency", "frame_inconsistency",
+             "degenerate_run")
 
 
 # ---------------------------------------------------------------- folder helpers

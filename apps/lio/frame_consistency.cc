@@ -253,7 +253,7 @@ FrameConsistency FrameConsistencyCheck::Result() const {
         text, sizeof(text),
         "the accelerometer disagrees with the accelerations of the lidar trajectory: "
         "residual RMS %.3g m/s^2 over %d windows of %.1f s (threshold %.3g; clean "
-        "simulated runs 0.005 to 0.098); a fitted 3x3 map M (f -> M f) leaves %.3g "
+        "simulated runs 0.002 to 0.14); a fitted 3x3 map M (f -> M f) leaves %.3g "
         "(|M - I| = %.2f%s%s): the accelerometer's sign or axes (a flipped or swapped "
         "column), the IMU's mounting (extrinsic rotation), a clock offset between IMU and "
         "lidar (calibration: estimate_time_offset), or a diverged estimate",

@@ -38,6 +38,29 @@ std::string UnregisteredRunReason(const std::vector<lio::ScanResult>& scans) {
          "outside lidar_frontend.min_range/max_range, or an unusable time field?)";
 }
 
+std::string DegenerateRunWarning(const std::vector<lio::ScanResult>& scans, double max_fraction) {
+  if (scans.size() < 2) return "";
+  size_t degenerate = 0, first = 0;
+  for (size_t i = 1; i < scans.size(); ++i) {
+    if (scans[i].status != lio::ScanStatus::kDegenerate) continue;
+    if (degenerate++ == 0) first = i;
+  }
+  const size_t judged = scans.size() - 1;
+  if (degenerate < 3 || double(degenerate) <= max_fraction * double(judged) ||
+      degenerate == judged) {
+    return "";
+  }
+  char text[600];
+  std::snprintf(text, sizeof(text),
+                "%zu of %zu scans degenerate (first: scan %zu at %.3f s): the lidar did not fix "
+                "their pose, which there is the motion prior's and the IMU's dead reckoning; too "
+                "few points or planes after subsampling (lidar_frontend.voxel_size, "
+                "keypoint_voxel_size, max_keypoints), points outside min_range/max_range, or a "
+                "featureless scene",
+                degenerate, judged, first, 1e-9 * double(scans[first].t_ns));
+  return text;
+}
+
 LidarGaps FindLidarGaps(const std::vector<int64_t>& scan_ends_ns, double factor) {
   LidarGaps g;
   if (scan_ends_ns.size() < 3) {

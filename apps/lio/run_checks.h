@@ -26,6 +26,15 @@ namespace ctlio::lioapp {
 // (RunOdometry fails it for its missing trajectory).
 std::string UnregisteredRunReason(const std::vector<lio::ScanResult>& scans);
 
+// A run in which the lidar fixed only part of the poses: more than `max_fraction` of the scans
+// after the first (and at least 3) have status `degenerate`, so there the trajectory is the
+// motion prior's and the IMU's dead reckoning. Empty otherwise (and for an unregistered run,
+// which UnregisteredRunReason reports). A voxel size near the lidar's range (every second scan
+// degenerate, 5x the clean ATE, exit 0 with no warning) is the case that asked for it; a
+// featureless scene gives the same count and deserves the same warning.
+std::string DegenerateRunWarning(const std::vector<lio::ScanResult>& scans,
+                                 double max_fraction = 0.1);
+
 // Lidar gaps among consecutive scan end times (increasing): a spacing above `factor` × the median
 // spacing. Needs 3 scans (2 spacings) for a median.
 struct LidarGaps {

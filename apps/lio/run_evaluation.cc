@@ -82,6 +82,7 @@ void WriteRunEvaluation(const RunSummary& run,
   }
   // An estimate the lidar never fixed has no ATE; the line says why (run_checks.h).
   if (!run.unregistered_run.empty()) ev << "no_ate \"" << run.unregistered_run << "\"\n";
+  if (!run.degenerate_run.empty()) ev << "degenerate_run \"" << run.degenerate_run << "\"\n";
   if (!run.first_input_warning.empty()) {
     ev << "first_input_warning \"" << run.first_input_warning << "\"\n";
   }
@@ -226,6 +227,9 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
   for (const auto& r : runs) {
     if (!r.unregistered_run.empty()) {
       std::printf("  %-10s FAILED, no ATE: %s\n", r.method.c_str(), r.unregistered_run.c_str());
+    }
+    if (!r.degenerate_run.empty()) {
+      std::printf("  %-10s WARNING lidar: %s\n", r.method.c_str(), r.degenerate_run.c_str());
     }
     if (r.lidar_gaps > 0) {
       std::printf("  %-10s lidar: %d gap(s) over 3x the median scan period (first: %s)\n",

@@ -432,6 +432,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     run.live_ate.reset();
     run.drift_per_100m.reset();
   }
+  run.degenerate_run = DegenerateRunWarning(run.scans);
+  if (!run.degenerate_run.empty()) {
+    LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.degenerate_run;
+  }
   run.input_defects = source.InputDefects();
   const LidarGaps gaps = FindLidarGaps(scan_ends);
   run.lidar_gaps = gaps.count;

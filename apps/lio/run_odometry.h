@@ -144,6 +144,7 @@ struct RunSummary {
   // is a failure without an ATE (`ate` and `live_ate` empty): why, here. Lidar gaps (scan ends
   // spaced more than 3× the median) are a warning: their count and the first.
   std::string unregistered_run;
+  std::string degenerate_run;  // DegenerateRunWarning (run_checks.h)
   int lidar_gaps = 0;
   std::string first_lidar_gap;
   // IMU–lidar consistency (CheckImuConsistency): the medians over the moving scans, and the

@@ -35,6 +35,7 @@
 #include "ctlio/io/pointcloud2.h"
 #include "ctlio/io/ros_wire_check.h"
 #include "ctlio/io/rosbag_source.h"
+#include "ctlio/io/warning_limiter.h"
 #include "io/small_pointcloud2.h"
 
 namespace ctlio::io {
@@ -434,6 +435,63 @@ TEST(BagRecovery, EmptyAllNonFiniteAndZeroDurationScansAreHandedOnAndCounted) {
     for (const std::string& l : lines) found = found || l.find(needle) != std::string::npos;
     EXPECT_TRUE(found) << needle;
   }
+}
+
+// The bag's IMU stream (BagSource::Impl::AddImu, shared with ROS 2 bags): a repeated stamp is
+// dropped and counted among the run's input defects (an error under --strict), as in the folder
+// readers; a stamp going backwards is an error naming the topic and message.
+TEST(BagImu, ADuplicateStampIsCountedAndTimeBackwardsIsAnErrorNamingTheMessage) {
+  const fs::path d = testing::FreshTempDir("bag_imu");
+  auto write = [&](const std::string& name, int64_t sixth_ns) {
+    const std::string path = (d / name).string();
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    for (int k = 1; k <= 40; ++k) {
+      sensor_msgs::Imu m;
+      m.header.stamp.fromNSec(uint64_t(k == 6 ? sixth_ns : k * 10'000'000LL));
+      m.header.frame_id = "imu";
+      m.linear_acceleration.z = 9.81;
+      bag.write("/imu", ros::Time(0.001 * k), m);
+    }
+    const sensor_msgs::PointCloud2 c = GoodCloud();
+    bag.write("/points", c.header.stamp, c);
+    return path;
+  };
+  const std::string dup = write("dup.bag", 50'000'000);  // the fifth sample's stamp again
+  {
+    WarningSink sink;
+    RosbagSource s(dup);
+    ScanFrame f;
+    while (s.Next(&f)) {
+    }
+    const auto defects = s.InputDefects();
+    bool counted = false;
+    for (const InputDefect& x : defects) {
+      if (x.kind != "duplicate IMU time") continue;
+      counted = true;
+      EXPECT_EQ(x.count, 1u);
+      EXPECT_THAT(x.first, HasSubstr("dup.bag: topic /imu, message 6"));
+    }
+    EXPECT_TRUE(counted) << "not among the input defects";
+  }
+  WarningLimiter::SetStrict(true);
+  ExpectError(
+      [&] {
+        RosbagSource s(dup);
+        ScanFrame f;
+        while (s.Next(&f)) {
+        }
+      },
+      {"dup.bag: topic /imu, message 6", "duplicate IMU time", "--strict"});
+  WarningLimiter::SetStrict(false);
+  const std::string back = write("back.bag", 45'000'000);
+  ExpectError(
+      [&] {
+        RosbagSource s(back);
+        ScanFrame f;
+        while (s.Next(&f)) {
+        }
+      },
+      {"back.bag: topic /imu, message 6", "IMU time goes backwards"});
 }
 
 }  // namespace

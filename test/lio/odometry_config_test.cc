@@ -182,6 +182,23 @@ TEST(OdometryConfig, CountKeysOutOfRangeNameFileLineKeyAndRange) {
   EXPECT_THROW(config.Validate(), std::invalid_argument);
   config.frontend.max_points_per_voxel = 20;
   EXPECT_NO_THROW(config.Validate());
+  // A voxel wider than the range: a few points per sweep, the lidar fixes no pose (the probe's
+  // voxel_size 1e30 ran with exit 0 at 5x the clean ATE).
+  for (double* size : {&config.frontend.voxel_size, &config.frontend.initial_voxel_size,
+                       &config.frontend.keypoint_voxel_size, &config.frontend.map_voxel_size}) {
+    const double kept = *size;
+    *size = 1e30;
+    try {
+      config.Validate();
+      ADD_FAILURE() << "voxel size 1e30 accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("must not exceed max_range"), std::string::npos)
+          << e.what();
+    }
+    *size = config.frontend.max_range;
+    EXPECT_NO_THROW(config.Validate());
+    *size = kept;
+  }
 }
 
 TEST(OdometryConfig, KnotsPerScan) {

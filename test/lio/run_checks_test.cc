@@ -131,6 +131,31 @@ TEST(RunChecks, LidarGapsAndUnregisteredRunsByTheirDefinition) {
   EXPECT_EQ(lioapp::UnregisteredRunReason({scans[0]}), "");
 }
 
+// A run whose lidar fixed only part of the poses (the probe's lidar_frontend.voxel_size 50 and
+// 1e30: 20 of 40 scans degenerate, 5x the clean ATE, exit 0) is warned about; a few degenerate
+// scans are not, and a run with none registered is UnregisteredRunReason's.
+TEST(RunChecks, ARunWithManyDegenerateScansIsWarned) {
+  std::vector<ScanResult> scans(41);
+  for (size_t i = 0; i < scans.size(); ++i) {
+    scans[i].status = ScanStatus::kOk;
+    scans[i].t_ns = int64_t(i) * 100'000'000;
+  }
+  EXPECT_EQ(lioapp::DegenerateRunWarning(scans), "");
+  for (size_t i = 21; i < scans.size(); ++i) scans[i].status = ScanStatus::kDegenerate;
+  const std::string w = lioapp::DegenerateRunWarning(scans);
+  EXPECT_NE(w.find("20 of 40 scans degenerate (first: scan 21 at 2.100 s)"), std::string::npos)
+      << w;
+  EXPECT_NE(w.find("lidar_frontend.voxel_size"), std::string::npos) << w;
+  // 4 of 40 (10 %): not warned.
+  for (size_t i = 21; i < 37; ++i) scans[i].status = ScanStatus::kOk;
+  EXPECT_EQ(lioapp::DegenerateRunWarning(scans), "");
+  scans[5].status = ScanStatus::kDegenerate;  // 5 of 40
+  EXPECT_NE(lioapp::DegenerateRunWarning(scans), "");
+  for (size_t i = 1; i < scans.size(); ++i) scans[i].status = ScanStatus::kDegenerate;
+  EXPECT_EQ(lioapp::DegenerateRunWarning(scans), "");  // unregistered: a failure, not this
+  EXPECT_NE(lioapp::UnregisteredRunReason(scans), "");
+}
+
 // Issue 40: scan intervals that overlap (each scan's end 0.15 s late, past the next scan's start)
 // are named by the runner as such; the gravity initialisation they spoil (its window lands in
 // motion) no longer blames only the accelerometer's units.

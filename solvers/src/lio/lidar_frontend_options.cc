@@ -22,6 +22,13 @@ void LidarFrontendOptions::Validate() const {
   require(keypoint_voxel_size > 0.0, "keypoint_voxel_size must be positive");
   require(max_keypoints >= 0, "max_keypoints must be >= 0 (0 = no cap)");
   require(map_voxel_size > 0.0, "map_voxel_size must be positive");
+  // A voxel wider than the lidar's range keeps a handful of points per sweep: the lidar then
+  // fixes no pose and the run is IMU dead reckoning with exit 0 (voxel_size 1e30 gave 5x the
+  // clean ATE, every second scan degenerate, no error).
+  require(voxel_size <= max_range && initial_voxel_size <= max_range &&
+              keypoint_voxel_size <= max_range && map_voxel_size <= max_range,
+          "voxel sizes (voxel_size, initial_voxel_size, keypoint_voxel_size, map_voxel_size) "
+          "must not exceed max_range");
   require(max_points_per_voxel >= 1 && max_points_per_voxel <= kMaxPointsPerVoxel,
           "max_points_per_voxel must be in [1, 10000]");
   require(min_point_distance >= 0.0, "min_point_distance must be >= 0");

@@ -12,7 +12,13 @@ void BagSource::Impl::AddImu(const sensor_msgs::Imu& m) {
   ++imu_messages;
   const int64_t t = int64_t(m.header.stamp.toNSec());
   if (t == last_imu_ns) {
-    if (duplicates++ == 0) LOG(WARNING) << Where(imu_topic, imu_messages) << "duplicate IMU time";
+    // Counted by the limiter as in the folder readers: reported in the run's input defects and
+    // an error under --strict (it used to be a log line only).
+    ++duplicates;
+    if (warnings->Count("duplicate IMU time", Where(imu_topic, imu_messages) + "IMU time " +
+                                                  std::to_string(t) + " ns repeated")) {
+      LOG(WARNING) << Where(imu_topic, imu_messages) << "duplicate IMU time; sample dropped";
+    }
     return;
   }
   if (t < last_imu_ns) {
