@@ -294,11 +294,18 @@ void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, Li
     return;
   }
   const double scale = config_.pose_covariance_lidar_scale;
+  const double floor_m = config_.pose_covariance_lidar_floor_m;
+  const double floor_rad = config_.pose_covariance_lidar_floor_rad;
   const std::optional<Mat6> S =
-      scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
-                                    estimator_->NewestPoseTangentFromBody())
-                   : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
-                                          estimator_->NewestPoseTangentFromBody());
+      floor_m > 0.0 || floor_rad > 0.0
+          ? floored_covariance_.Compute(
+                window_, pose, estimator_->NewestKeys(), lidar, scale,
+                (Vec6() << floor_m, floor_m, floor_m, floor_rad, floor_rad, floor_rad).finished(),
+                result->T_mr, estimator_->NewestPoseTangentFromBody())
+      : scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
+                                      estimator_->NewestPoseTangentFromBody())
+                     : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
+                                            estimator_->NewestPoseTangentFromBody());
   if (!S) return;
   result->pose_covariance = *S;
   result->has_pose_covariance = true;

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "ctlio/solvers/lio/adaptive_covariance.h"
+#include "ctlio/solvers/lio/lidar_floor_covariance.h"
 #include "ctlio/solvers/lio/calibration_states.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/final_trajectory.h"
@@ -158,6 +159,7 @@ class LioOdometry {
   std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
   AdaptiveNoiseScales covariance_scales_;  // window.pose_covariance_adaptive
+  FlooredPoseCovariance floored_covariance_;  // window.pose_covariance_lidar_floor_*
   CalibrationStates calibration_;
   int num_marginalizations_ = 0;
   PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused
