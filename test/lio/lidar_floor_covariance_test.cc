@@ -3,10 +3,12 @@
 // shares a rigid error in the robot frame, and the NEES of such scans' mean over many draws.
 #include "ctlio/solvers/lio/lidar_floor_covariance.h"
 
+#include <ceres/sized_cost_function.h>
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "ctlio/factors/priors/linear_measurement.h"
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/solvers/lio/pose_covariance.h"
 
@@ -114,6 +116,62 @@ TEST(FlooredLidarPoseCovariance, ScansSharingARigidErrorHaveConsistentNees) {
   }
   EXPECT_NEAR(nees, 6.0, 0.6);
   EXPECT_GT(nees_unfloored, 20.0);
+}
+
+// x_b − x_a of two 6-vectors, covariance Q: the motion between two scans' states (test only).
+class Difference final : public ceres::SizedCostFunction<6, 6, 6> {
+ public:
+  explicit Difference(const Mat6& Q) : W_(Mat6(Q.llt().matrixL()).inverse()) {}
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    using Jacobian = Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>;
+    Eigen::Map<Vec6> residual(r);
+    residual = W_ * (Eigen::Map<const Vec6>(x[1]) - Eigen::Map<const Vec6>(x[0]));
+    if (J != nullptr && J[0] != nullptr) Jacobian{J[0]} = -W_;
+    if (J != nullptr && J[1] != nullptr) Jacobian{J[1]} = W_;
+    return true;
+  }
+
+ private:
+  Mat6 W_;
+};
+
+// A linear chain run as the odometry runs its window (knots: 2, the oldest marginalised before
+// each new one): states x_k ∈ R⁶ (T_mr = identity, tangent_from_body = I), a motion
+// x_k − x_{k−1} ~ N(0, Q) and a "scan" z_k = x_k + n, n ~ N(0, P_l). The carried covariance is
+// the Kalman filter's with the scan's covariance c·P_l + Σ_c at every step; the window's own
+// marginal prior, holding the earlier scans at P_l, is not.
+TEST(FlooredPoseCovariance, IsTheKalmanFilterOfTheFlooredScans) {
+  std::mt19937 rng(9);
+  const Mat6 Q = RandomSpd(&rng, 1e-5), P_l = RandomSpd(&rng, 1e-4), P0 = RandomSpd(&rng, 1e-2);
+  const double c = 0.3;
+  const Vec6 floor_sigma = (Vec6() << 0.004, 0.004, 0.004, 0.003, 0.003, 0.003).finished();
+  const Mat6 R = c * P_l + Mat6(floor_sigma.cwiseAbs2().asDiagonal());
+  SlidingWindow window;
+  FlooredPoseCovariance carried;
+  Mat6 P = (P0.inverse() + R.inverse()).inverse();  // the filter after the first scan
+  double window_gap = 0.0;
+  for (StateId k = 0; k < 8; ++k) {
+    if (k > 1) window.Marginalize({k - 2});  // the window keeps the state before the new one
+    window.AddVectorState(k, Vec6::Zero());
+    if (k == 0) {
+      window.AddResidualBlock(LinearMeasurement<6, 6>::Leading(Vec6::Zero(), P0), nullptr, {k});
+    } else {
+      window.AddResidualBlock(new Difference(Q), nullptr, {k - 1, k});
+      P = ((P + Q).inverse() + R.inverse()).inverse();
+    }
+    const auto scan =
+        window.AddResidualBlock(LinearMeasurement<6, 6>::Leading(Vec6::Zero(), P_l), nullptr, {k});
+    const auto S = carried.Compute(window, k, {k}, {scan}, c, floor_sigma, SE3(), Mat6::Identity());
+    ASSERT_TRUE(S.has_value());
+    EXPECT_EQ(carried.used_carried_prior(), k > 0);
+    EXPECT_LT((*S - P).norm(), 1e-8 * P.norm()) << "scan " << k;
+    const auto W =
+        FlooredLidarPoseCovariance(window, k, {scan}, c, floor_sigma, SE3(), Mat6::Identity());
+    ASSERT_TRUE(W.has_value());
+    window_gap = (*W - P).norm() / P.norm();
+  }
+  // Flooring the newest scan alone (the window's prior as solved) is a different covariance.
+  EXPECT_GT(window_gap, 0.1);
 }
 
 }  // namespace
