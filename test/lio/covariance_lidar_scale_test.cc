@@ -120,5 +120,38 @@ TEST(CovarianceLidarFloor, SameEstimateOwnCovariance) {
   EXPECT_LT(translation_f, 0.8 * translation);
 }
 
+// window.pose_covariance_map_sigma_m/_rad: the map's error added to the reported covariance in ε
+// (a left perturbation in the map frame), for both methods; the estimates bit for bit.
+TEST(CovarianceMapError, AddsTheMapCovariance) {
+  for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+    sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
+    c.duration_s = 1.0;
+    c.lidar.beams = 16;
+    c.lidar.firing_decimation = 8;
+    OdometryConfig config = testing::SimLioConfig();
+    config.method = m;
+    config.pose_covariance = true;
+    config.pose_covariance_adaptive = false;
+    sim::SimulatedSource a_source(c), b_source(c);
+    const lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
+    config.pose_covariance_map_sigma_m = 0.03;
+    config.pose_covariance_map_sigma_rad = 0.002;
+    const lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+    ASSERT_EQ(a.scans.size(), b.scans.size());
+    const Mat6 map = (Vec6() << 9e-4, 9e-4, 9e-4, 4e-6, 4e-6, 4e-6).finished().asDiagonal();
+    int compared = 0;
+    for (size_t k = 0; k < a.scans.size(); ++k) {
+      EXPECT_EQ(a.scans[k].T_mr.Matrix(), b.scans[k].T_mr.Matrix()) << LioMethodName(m) << k;
+      if (!a.scans[k].has_pose_covariance || !b.scans[k].has_pose_covariance) continue;
+      const Mat6 added = b.scans[k].pose_covariance - a.scans[k].pose_covariance;
+      // The two runs' covariances agree to round-off (~1e-10 of their size).
+      EXPECT_LT((added - map).norm(), 1e-8 * b.scans[k].pose_covariance.norm())
+          << LioMethodName(m) << " scan " << k;
+      ++compared;
+    }
+    EXPECT_GE(compared, 5) << LioMethodName(m);
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio

@@ -289,7 +289,7 @@ void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, Li
         &window_, pose, lidar_estimate, lidar, imu.accel, imu.gyro, last_marginalization_.prior,
         result->T_mr, estimator_->NewestPoseTangentFromBody());
     if (!S) return;
-    result->pose_covariance = *S;
+    result->pose_covariance = *S + MapCovariance();
     result->has_pose_covariance = true;
     return;
   }
@@ -307,8 +307,15 @@ void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, Li
                      : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
                                             estimator_->NewestPoseTangentFromBody());
   if (!S) return;
-  result->pose_covariance = *S;
+  result->pose_covariance = *S + MapCovariance();
   result->has_pose_covariance = true;
+}
+
+Mat6 LioOdometry::MapCovariance() const {
+  // ε is a left perturbation in the map frame: a rigid map error Exp(m) adds Cov(m) (see
+  // OdometryConfig::pose_covariance_map_sigma_m).
+  const double t = config_.pose_covariance_map_sigma_m, r = config_.pose_covariance_map_sigma_rad;
+  return (Vec6() << t * t, t * t, t * t, r * r, r * r, r * r).finished().asDiagonal();
 }
 
 void LioOdometry::Slide(ScanResult* result) {
