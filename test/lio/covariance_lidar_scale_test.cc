@@ -19,7 +19,8 @@ double MinEigenvalue(const Mat6& A) {
   return Eigen::SelfAdjointEigenSolver<Mat6>(0.5 * (A + A.transpose())).eigenvalues()[0];
 }
 
-lioapp::RunSummary RunWithScale(LioMethod m, double scale, bool adaptive = false) {
+lioapp::RunSummary RunWithScale(LioMethod m, double scale, bool adaptive = false,
+                                double floor_m = 0.0, double floor_rad = 0.0) {
   sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
   c.duration_s = 1.0;
   c.lidar.beams = 16;
@@ -31,6 +32,8 @@ lioapp::RunSummary RunWithScale(LioMethod m, double scale, bool adaptive = false
   // data/sim_lio.yaml turns the adaptive covariance on for Singer-LIO; per_method is applied by
   // the loader, so it is set here for the method run.
   config.pose_covariance_adaptive = adaptive;
+  config.pose_covariance_lidar_floor_m = floor_m;
+  config.pose_covariance_lidar_floor_rad = floor_rad;
   sim::SimulatedSource source(c);
   return lioapp::RunOdometry(source, config, lioapp::RunOptions{});
 }
@@ -89,6 +92,64 @@ TEST(CovarianceAdaptive, SameEstimateOwnCovariance) {
     }
     EXPECT_GE(compared, 5) << LioMethodName(m);
     EXPECT_GE(differ, compared - 1) << LioMethodName(m);  // the first scan's factors are all 1
+  }
+}
+
+// window.pose_covariance_lidar_floor_* (lidar_floor_covariance.h) is covariance only: the
+// baseline's estimates bit for bit, a positive definite covariance at every scan the window gives
+// one, and with the point noise at c = 0.16 a smaller translation block than the window's over
+// the run (the lidar's translation information ×6, its rotation capped by the floor).
+TEST(CovarianceLidarFloor, SameEstimateOwnCovariance) {
+  const lioapp::RunSummary base = RunWithScale(LioMethod::kImuInput, 1.0);
+  const lioapp::RunSummary floored = RunWithScale(LioMethod::kImuInput, 0.16, false, 0.002, 0.0002);
+  ASSERT_EQ(base.scans.size(), floored.scans.size());
+  int compared = 0;
+  double translation = 0.0, translation_f = 0.0;
+  for (size_t k = 0; k < base.scans.size(); ++k) {
+    const ScanResult& a = base.scans[k];
+    const ScanResult& b = floored.scans[k];
+    EXPECT_EQ(a.T_mr.Matrix(), b.T_mr.Matrix()) << "scan " << k;
+    EXPECT_EQ(a.has_pose_covariance, b.has_pose_covariance) << "scan " << k;
+    if (!a.has_pose_covariance || !b.has_pose_covariance) continue;
+    EXPECT_GT(MinEigenvalue(b.pose_covariance), 0.0) << "scan " << k;
+    translation += a.pose_covariance.topLeftCorner<3, 3>().trace();
+    translation_f += b.pose_covariance.topLeftCorner<3, 3>().trace();
+    ++compared;
+  }
+  EXPECT_GE(compared, 5);
+  EXPECT_LT(translation_f, 0.8 * translation);
+}
+
+// window.pose_covariance_map_sigma_m/_rad: the map's error added to the reported covariance in ε
+// (a left perturbation in the map frame), for both methods; the estimates bit for bit.
+TEST(CovarianceMapError, AddsTheMapCovariance) {
+  for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+    sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
+    c.duration_s = 1.0;
+    c.lidar.beams = 16;
+    c.lidar.firing_decimation = 8;
+    OdometryConfig config = testing::SimLioConfig();
+    config.method = m;
+    config.pose_covariance = true;
+    config.pose_covariance_adaptive = false;
+    sim::SimulatedSource a_source(c), b_source(c);
+    const lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
+    config.pose_covariance_map_sigma_m = 0.03;
+    config.pose_covariance_map_sigma_rad = 0.002;
+    const lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+    ASSERT_EQ(a.scans.size(), b.scans.size());
+    const Mat6 map = (Vec6() << 9e-4, 9e-4, 9e-4, 4e-6, 4e-6, 4e-6).finished().asDiagonal();
+    int compared = 0;
+    for (size_t k = 0; k < a.scans.size(); ++k) {
+      EXPECT_EQ(a.scans[k].T_mr.Matrix(), b.scans[k].T_mr.Matrix()) << LioMethodName(m) << k;
+      if (!a.scans[k].has_pose_covariance || !b.scans[k].has_pose_covariance) continue;
+      const Mat6 added = b.scans[k].pose_covariance - a.scans[k].pose_covariance;
+      // The two runs' covariances agree to round-off (~1e-10 of their size).
+      EXPECT_LT((added - map).norm(), 1e-8 * b.scans[k].pose_covariance.norm())
+          << LioMethodName(m) << " scan " << k;
+      ++compared;
+    }
+    EXPECT_GE(compared, 5) << LioMethodName(m);
   }
 }
 

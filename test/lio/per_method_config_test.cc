@@ -110,6 +110,29 @@ TEST(PerMethodConfig, PoseCovarianceLidarScaleIsPerMethodAndPositive) {
   }
 }
 
+// The lidar floor of the pose covariance: per method (data/sim_lio.yaml sets it for the
+// baseline only); it and the map's σ negative, absurd or NaN: an error naming the key.
+TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
+  const OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  EXPECT_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_lidar_floor_m, 0.0);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_m, 0.002);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_rad, 0.0002);
+  EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_scale, 0.16);
+  for (const char* key : {"pose_covariance_lidar_floor_m", "pose_covariance_lidar_floor_rad",
+                          "pose_covariance_map_sigma_m", "pose_covariance_map_sigma_rad"}) {
+    for (const char* bad : {"-0.001", "1e9", ".nan"}) {
+      const std::string path =
+          WriteTemp("floor_bad.yaml", std::string("window:\n  ") + key + ": " + bad + "\n");
+      try {
+        LoadOdometryConfig(path);
+        ADD_FAILURE() << "expected an error for " << key << " " << bad;
+      } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
 // The adaptive covariance's lidar inflation: per method as the data configs set it; below 1
 // (it inflates), absurd or NaN is an error naming the key.
 TEST(PerMethodConfig, PoseCovarianceLidarNeffIsPerMethodAndAtLeastOne) {

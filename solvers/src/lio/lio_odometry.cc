@@ -289,19 +289,33 @@ void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, Li
         &window_, pose, lidar_estimate, lidar, imu.accel, imu.gyro, last_marginalization_.prior,
         result->T_mr, estimator_->NewestPoseTangentFromBody());
     if (!S) return;
-    result->pose_covariance = *S;
+    result->pose_covariance = *S + MapCovariance();
     result->has_pose_covariance = true;
     return;
   }
   const double scale = config_.pose_covariance_lidar_scale;
+  const double floor_m = config_.pose_covariance_lidar_floor_m;
+  const double floor_rad = config_.pose_covariance_lidar_floor_rad;
   const std::optional<Mat6> S =
-      scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
-                                    estimator_->NewestPoseTangentFromBody())
-                   : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
-                                          estimator_->NewestPoseTangentFromBody());
+      floor_m > 0.0 || floor_rad > 0.0
+          ? floored_covariance_.Compute(
+                window_, pose, estimator_->NewestKeys(), lidar, scale,
+                (Vec6() << floor_m, floor_m, floor_m, floor_rad, floor_rad, floor_rad).finished(),
+                result->T_mr, estimator_->NewestPoseTangentFromBody())
+      : scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
+                                      estimator_->NewestPoseTangentFromBody())
+                     : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
+                                            estimator_->NewestPoseTangentFromBody());
   if (!S) return;
-  result->pose_covariance = *S;
+  result->pose_covariance = *S + MapCovariance();
   result->has_pose_covariance = true;
+}
+
+Mat6 LioOdometry::MapCovariance() const {
+  // ε is a left perturbation in the map frame: a rigid map error Exp(m) adds Cov(m) (see
+  // OdometryConfig::pose_covariance_map_sigma_m).
+  const double t = config_.pose_covariance_map_sigma_m, r = config_.pose_covariance_map_sigma_rad;
+  return (Vec6() << t * t, t * t, t * t, r * r, r * r, r * r).finished().asDiagonal();
 }
 
 void LioOdometry::Slide(ScanResult* result) {

@@ -151,6 +151,14 @@ void OdometryConfig::Validate() const {
   require(pose_covariance_lidar_scale > 0, "window.pose_covariance_lidar_scale must be positive");
   require(pose_covariance_lidar_neff >= 1.0 && pose_covariance_lidar_neff <= 1e6,
           "window.pose_covariance_lidar_neff must be in [1, 1e6]");
+  require(pose_covariance_lidar_floor_m >= 0 && pose_covariance_lidar_floor_m <= 1e3 &&
+              pose_covariance_lidar_floor_rad >= 0 && pose_covariance_lidar_floor_rad <= 10,
+          "window.pose_covariance_lidar_floor_m must be in [0, 1e3] and "
+          "window.pose_covariance_lidar_floor_rad in [0, 10]");
+  require(pose_covariance_map_sigma_m >= 0 && pose_covariance_map_sigma_m <= 1e3 &&
+              pose_covariance_map_sigma_rad >= 0 && pose_covariance_map_sigma_rad <= 10,
+          "window.pose_covariance_map_sigma_m must be in [0, 1e3] and "
+          "window.pose_covariance_map_sigma_rad in [0, 10]");
   require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
           "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
@@ -276,7 +284,11 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"pose_covariance", SetFromYaml(&c->pose_covariance)},
            {"pose_covariance_lidar_scale", SetFromYaml(&c->pose_covariance_lidar_scale)},
            {"pose_covariance_adaptive", SetFromYaml(&c->pose_covariance_adaptive)},
-           {"pose_covariance_lidar_neff", SetFromYaml(&c->pose_covariance_lidar_neff)}});
+           {"pose_covariance_lidar_neff", SetFromYaml(&c->pose_covariance_lidar_neff)},
+           {"pose_covariance_lidar_floor_m", SetFromYaml(&c->pose_covariance_lidar_floor_m)},
+           {"pose_covariance_lidar_floor_rad", SetFromYaml(&c->pose_covariance_lidar_floor_rad)},
+           {"pose_covariance_map_sigma_m", SetFromYaml(&c->pose_covariance_map_sigma_m)},
+           {"pose_covariance_map_sigma_rad", SetFromYaml(&c->pose_covariance_map_sigma_rad)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

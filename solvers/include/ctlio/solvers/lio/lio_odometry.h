@@ -34,6 +34,7 @@
 #include "ctlio/solvers/lio/final_trajectory.h"
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/imu_buffer.h"
+#include "ctlio/solvers/lio/lidar_floor_covariance.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/scan_registration.h"
 #include "ctlio/solvers/sliding_window.h"
@@ -126,6 +127,8 @@ class LioOdometry {
   // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
   void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
                             ScanResult* result);
+  // Σ_map of OdometryConfig::pose_covariance_map_sigma_m/_rad (ε convention).
+  Mat6 MapCovariance() const;
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
@@ -157,7 +160,8 @@ class LioOdometry {
   bool initialised_ = false;
   std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
-  AdaptiveNoiseScales covariance_scales_;  // window.pose_covariance_adaptive
+  AdaptiveNoiseScales covariance_scales_;     // window.pose_covariance_adaptive
+  FlooredPoseCovariance floored_covariance_;  // window.pose_covariance_lidar_floor_*
   CalibrationStates calibration_;
   int num_marginalizations_ = 0;
   PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused

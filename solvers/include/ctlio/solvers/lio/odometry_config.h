@@ -194,6 +194,21 @@ struct OdometryConfig {
   // terms' by variance components; the marginal prior's alike.
   bool pose_covariance_adaptive = false;
   double pose_covariance_lidar_neff = 10.0;
+  // window.pose_covariance_lidar_floor_m / _rad: an error floor of the scan's lidar term, σ of a
+  // rigid misregistration of the whole scan (per axis, robot frame) that its keypoints share and
+  // do not average out (lidar_floor_covariance.h; with pose_covariance_lidar_scale, the point
+  // noise's part; not with pose_covariance_adaptive). 0 and 0: no floor. Applied where the lidar
+  // term is on one pose (the IMU-as-input baseline); the estimate is unchanged.
+  double pose_covariance_lidar_floor_m = 0.0;
+  double pose_covariance_lidar_floor_rad = 0.0;
+  // window.pose_covariance_map_sigma_m / _rad: σ per axis (map frame) of the map's own error, a
+  // rigid error of the map that every later scan, registered against it, inherits: added to the
+  // reported covariance (lidar and the IMU, whose gravity is held in the map frame, measure the
+  // pose relative to the map only, so the posterior of T_mr is that relative to the map plus the
+  // map's, Σ = Σ_rel + Σ_map in ε). For an estimate whose start-up error stays in the map
+  // (sparse sensors; docs/experiments/covariance.md). 0 and 0: none. The estimate is unchanged.
+  double pose_covariance_map_sigma_m = 0.0;
+  double pose_covariance_map_sigma_rad = 0.0;
 
   // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
   // every one). Bounded so that the pipeline's memory does not grow with the length of the run
