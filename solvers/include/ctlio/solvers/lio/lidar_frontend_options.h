@@ -58,7 +58,8 @@ struct LidarFrontendOptions {
   int max_iterations = 10;
   int solver_iterations = 5;
   // The budget of a scan whose interval no IMU sample measures (lidar_only always; an IMU outage
-  // for the other methods, imu_residuals == 0): the lidar alone moves the pose from the motion
+  // for Singer-LIO and lidar_gyro, imu_residuals == 0; not the IMU-as-input baseline, whose gap
+  // mode is its own, lio_odometry.h): the lidar alone moves the pose from the motion
   // prior's prediction, which without the IMU can be degrees off (docs/experiments/imu-dropout.md),
   // so a budget tuned for an IMU-predicted start (2 rounds × 3) stops mid-way and the error grows
   // scan by scan (tuning index 101, hdl32e quad walk, 2 s outage: 29 m; 0.03 m with 10 × 5).
