@@ -46,6 +46,10 @@ void LidarFrontendOptions::Validate() const {
   // unbounded value is a run that never ends.
   require(max_iterations <= 100, "max_iterations must be <= 100 association rounds per scan");
   require(solver_iterations <= 1000, "solver_iterations must be <= 1000 per round");
+  require(max_iterations_without_imu >= 0 && max_iterations_without_imu <= 100,
+          "max_iterations_without_imu must be in [0, 100] (0 = max_iterations)");
+  require(solver_iterations_without_imu >= 0 && solver_iterations_without_imu <= 1000,
+          "solver_iterations_without_imu must be in [0, 1000] (0 = solver_iterations)");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
   require(residual_blocks == "point" || residual_blocks == "interval" ||
@@ -88,6 +92,8 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"threads", SetInRange(&o.threads, 1, kMaxConfigThreads, source, "lidar_frontend.threads")},
       {"max_iterations", SetFromYaml(&o.max_iterations)},
       {"solver_iterations", SetFromYaml(&o.solver_iterations)},
+      {"max_iterations_without_imu", SetFromYaml(&o.max_iterations_without_imu)},
+      {"solver_iterations_without_imu", SetFromYaml(&o.solver_iterations_without_imu)},
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},
       {"loss", SetFromYaml(&o.loss)},
       {"loss_scale", SetFromYaml(&o.loss_scale)},

@@ -37,7 +37,7 @@ void LidarTerm::SetBatchResiduals(const std::vector<uint8_t>& /*associated*/,
 }
 
 RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* term,
-                                               SlidingWindow* window) const {
+                                               SlidingWindow* window, int max_rounds) const {
   using Clock = std::chrono::steady_clock;
   RegistrationSummary summary;
   // One associator (neighbour buffer) per thread; the keypoints are placed in the map first
@@ -75,7 +75,8 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
   };
   const double reuse_squared = options_.reassociation_distance * options_.reassociation_distance;
   SE3 last_pose = term->NewestPose();
-  for (int round = 0; round < options_.max_iterations; ++round) {
+  const int rounds = max_rounds > 0 ? max_rounds : options_.max_iterations;
+  for (int round = 0; round < rounds; ++round) {
     // Associate at the current estimate.
     auto t0 = Clock::now();
     term->BeginRound();

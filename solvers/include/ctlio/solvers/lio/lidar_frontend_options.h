@@ -57,6 +57,16 @@ struct LidarFrontendOptions {
   // Registration: re-association rounds, solver iterations per round, robust loss.
   int max_iterations = 10;
   int solver_iterations = 5;
+  // The budget of a scan whose interval no IMU sample measures (lidar_only always; an IMU outage
+  // for Singer-LIO and lidar_gyro, imu_residuals == 0; not the IMU-as-input baseline, whose gap
+  // mode is its own, lio_odometry.h): the lidar alone moves the pose from the motion
+  // prior's prediction, which without the IMU can be degrees off (docs/experiments/imu-dropout.md),
+  // so a budget tuned for an IMU-predicted start (2 rounds × 3) stops mid-way and the error grows
+  // scan by scan (tuning index 101, hdl32e quad walk, 2 s outage: 29 m; 0.03 m with 10 × 5).
+  // Rounds still end at convergence. 0: max_iterations / solver_iterations. Scans with IMU
+  // samples keep the budget above, so runs without an outage are unchanged bit for bit.
+  int max_iterations_without_imu = 10;
+  int solver_iterations_without_imu = 5;
   // Standard deviation of a point-to-plane residual (range noise of an OS1-64 class lidar plus
   // plane-fit noise): residuals enter the problem as w/σ · nᵀ(p_ref − T_mr q), which sets their
   // weight against the GP prior (whitened by Q⁻¹, SPEC §2).

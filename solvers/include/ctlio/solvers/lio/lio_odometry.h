@@ -123,6 +123,11 @@ class LioOdometry {
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
+  // A GP method's scan that no IMU sample measures (lidar_only, or an outage): registered with
+  // lidar_frontend.max_iterations_without_imu, its degenerate directions remapped.
+  bool GpScanWithoutImu(const ScanResult& result) const;
+  // The scan's registration, with the budget of a scan without IMU measurements where it has none.
+  RegistrationSummary Register(LidarTerm* lidar, ScanResult* result);
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
   void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
@@ -133,7 +138,8 @@ class LioOdometry {
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
   // Degenerate directions of the registered lidar term (degeneracy.h): reported in the result;
-  // lidar_only keeps `predicted` (the newest pose state before registration) along them.
+  // lidar_only and a GP method in an IMU outage keep `predicted` (the newest pose state before
+  // registration) along them.
   void AnalyseDegeneracy(const RegistrationSummary& registered, const SE3& predicted,
                          ScanResult* result);
   // lidar_only with a degenerate direction: the scan is `degenerate` (remapped or not).

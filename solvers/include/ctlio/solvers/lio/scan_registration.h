@@ -99,7 +99,10 @@ class ScanRegistration {
  public:
   ScanRegistration(const LidarFrontendOptions& options, int min_associations);
 
-  RegistrationSummary Register(const VoxelMap& map, LidarTerm* term, SlidingWindow* window) const;
+  // max_rounds > 0 replaces options().max_iterations for this scan (the budget of a scan without
+  // IMU measurements, LidarFrontendOptions::max_iterations_without_imu).
+  RegistrationSummary Register(const VoxelMap& map, LidarTerm* term, SlidingWindow* window,
+                               int max_rounds = 0) const;
 
   const LidarFrontendOptions& options() const { return options_; }
 
