@@ -215,14 +215,12 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   estimator_->AddState(scan, &window_, result);
 
   const SE3 predicted = window_.Pose(estimator_->NewestPoseKey());
-  // A GP scan without IMU samples: its starting values, restored if the registration diverges.
-  std::vector<std::pair<StateId, Eigen::VectorXd>> start;
-  if (GpScanWithoutImu(*result)) {
-    for (const StateId id : estimator_->NewestKeys()) start.emplace_back(id, window_.Vector(id));
-  }
+  without_imu_.Begin(ScanWithoutImu::Applies(config_.method, *result), estimator_->NewestKeys(),
+                     window_);
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
   calibration_.Hold(scan.t_end, &window_, result);
-  const RegistrationSummary registered = Register(lidar.get(), result);
+  const RegistrationSummary registered = without_imu_.Register(
+      config_.frontend, registration_, frontend_.map(), lidar.get(), &window_);
   calibration_.Release(&window_);
   if (!registered.degenerate) AnalyseDegeneracy(registered, predicted, result);
   result->rounds = registered.rounds;
@@ -241,19 +239,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const auto t_map = std::chrono::steady_clock::now();
   const bool plausible = EstimatePlausible(result);
-  bool restored = false;
-  if (!plausible && !start.empty()) {
-    // Nothing but the lidar moved these states (no IMU sample): the scan stays failed, but its
-    // lidar residuals leave the window and the states return to the prediction, so that the next
-    // scan starts from the prediction instead of from the diverged pose, which no later scan
-    // recovers from (lidar_only, vlp16 park walk 100: 95 failed scans of 100 after a jump at its
-    // third scan; docs/experiments/imu-dropout.md).
-    for (const ceres::ResidualBlockId id : registered.lidar_blocks) window_.RemoveResidualBlock(id);
-    for (const auto& [id, value] : start) {
-      std::copy(value.data(), value.data() + value.size(), window_.State(id));
-    }
-    restored = true;
-  }
+  const bool restored = !plausible && without_imu_.Restore(registered, &window_);
   if (plausible) {
     estimator_->MapPoints(scan, &map_points_);
     map_position_ = estimator_->NewestPose().translation();
@@ -273,30 +259,6 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   estimator_->Report(result);
   if (config_.pose_covariance && !restored) ReportPoseCovariance(registered, lidar.get(), result);
   calibration_.Report(estimator_->NewestKeys(), &window_, result);
-}
-
-bool LioOdometry::GpScanWithoutImu(const ScanResult& result) const {
-  // The IMU-as-input baseline bridges a gap its own way (constant-twist prediction, velocity
-  // random walk; nav_state_estimator.h): with the budget and the remapping below it diverged on
-  // the 1 s outage of lio.ImuDropout.EveryMethodRunsThroughAOneSecondOutage (a 5.1 m jump).
-  return config_.method != LioMethod::kImuInput && result.imu_residuals == 0;
-}
-
-RegistrationSummary LioOdometry::Register(LidarTerm* lidar, ScanResult* result) {
-  // No IMU sample measures this scan's interval (lidar_only, or an outage): the lidar alone moves
-  // the pose from the prior's prediction, with the larger budget of such scans
-  // (lidar_frontend.max_iterations_without_imu).
-  const LidarFrontendOptions& o = config_.frontend;
-  if (!GpScanWithoutImu(*result)) {
-    return registration_.Register(frontend_.map(), lidar, &window_);
-  }
-  int& iterations = window_.options().solver.max_num_iterations;
-  const int kept = iterations;
-  if (o.solver_iterations_without_imu > 0) iterations = o.solver_iterations_without_imu;
-  RegistrationSummary registered =
-      registration_.Register(frontend_.map(), lidar, &window_, o.max_iterations_without_imu);
-  iterations = kept;
-  return registered;
 }
 
 void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
@@ -455,7 +417,7 @@ void LioOdometry::AnalyseDegeneracy(const RegistrationSummary& registered, const
   if (report.directions.empty()) return;
   const Vec6& u = report.directions.front();
   report.prior_information = u.dot(OtherInformation(window_, registered.lidar_blocks, pose, A) * u);
-  if (!GpScanWithoutImu(*result) || !o.remap) return;
+  if (!without_imu_.active() || !o.remap) return;
   // No IMU measures the scan (lidar_only, or an IMU outage): keep the prediction along the
   // degenerate directions (solution remapping, degeneracy.h) and re-solve the other directions
   // with it. In an outage the estimate along them is otherwise the registration's drift (tuning

@@ -37,6 +37,7 @@
 #include "ctlio/solvers/lio/lidar_floor_covariance.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/scan_registration.h"
+#include "ctlio/solvers/lio/scan_without_imu.h"
 #include "ctlio/solvers/sliding_window.h"
 
 namespace ctlio::lio {
@@ -123,11 +124,6 @@ class LioOdometry {
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
-  // A GP method's scan that no IMU sample measures (lidar_only, or an outage): registered with
-  // lidar_frontend.max_iterations_without_imu, its degenerate directions remapped.
-  bool GpScanWithoutImu(const ScanResult& result) const;
-  // The scan's registration, with the budget of a scan without IMU measurements where it has none.
-  RegistrationSummary Register(LidarTerm* lidar, ScanResult* result);
   // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
   // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
   void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
@@ -169,6 +165,7 @@ class LioOdometry {
   AdaptiveNoiseScales covariance_scales_;     // window.pose_covariance_adaptive
   FlooredPoseCovariance floored_covariance_;  // window.pose_covariance_lidar_floor_*
   CalibrationStates calibration_;
+  ScanWithoutImu without_imu_;  // lidar_only, or a scan in an IMU outage
   int num_marginalizations_ = 0;
   PreparedScan prepared_;  // the scan being processed (PrepareScan), its buffers reused
   // Its points in the map frame (MapPoints) and the robot position they are inserted at: on the

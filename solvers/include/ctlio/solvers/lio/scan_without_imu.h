@@ -1,0 +1,51 @@
+// A GP method's scan that no IMU sample measures: every lidar_only scan, and a Singer-LIO or
+// lidar_gyro scan inside an IMU outage (docs/experiments/imu-dropout.md). Only the lidar moves its
+// states away from the prior's prediction, so such a scan
+// - is registered with its own, larger budget (LidarFrontendOptions::max_iterations_without_imu,
+//   solver_iterations_without_imu): the normal 2 rounds × 3 iterations stop before converging and
+//   the error compounds (hdl32e quad walk 101, 2 s outage: 29 m, with the larger budget 0.029 m);
+// - keeps the prediction along its degenerate directions (LioOdometry::AnalyseDegeneracy);
+// - if its estimate is implausible, goes back to the prediction: its lidar residuals leave the
+//   window and its states get their starting values again, so that the next scan starts from the
+//   prediction instead of from the diverged pose, which no later scan recovers from (lidar_only,
+//   vlp16 park walk 100: 95 failed scans of 100 after a jump at its third scan).
+// Scans with IMU samples are untouched: runs without an outage are the same bit for bit.
+#pragma once
+
+#include <Eigen/Core>
+#include <utility>
+#include <vector>
+
+#include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/lio/scan_registration.h"
+#include "ctlio/solvers/sliding_window.h"
+
+namespace ctlio::lio {
+
+class ScanWithoutImu {
+ public:
+  // Whether `result`'s scan is one. Not the IMU-as-input baseline: it bridges a gap its own way
+  // (constant-twist prediction, velocity random walk; nav_state_estimator.h), and with the budget
+  // and the remapping it diverged on the 1 s outage of
+  // lio.ImuDropout.EveryMethodRunsThroughAOneSecondOutage (a 5.1 m jump).
+  static bool Applies(LioMethod method, const ScanResult& result);
+
+  // The start of a scan: if `applies`, keeps the values of its states `keys` (the prediction).
+  void Begin(bool applies, const std::vector<StateId>& keys, const SlidingWindow& window);
+  // Whether the scan begun last is one.
+  bool active() const { return !start_.empty(); }
+
+  // The scan's registration, with the budget of a scan without IMU samples when active().
+  RegistrationSummary Register(const LidarFrontendOptions& options,
+                               const ScanRegistration& registration, const VoxelMap& map,
+                               LidarTerm* term, SlidingWindow* window) const;
+
+  // After an implausible estimate: when active(), removes the scan's lidar residuals and restores
+  // the starting values; returns whether it did.
+  bool Restore(const RegistrationSummary& registered, SlidingWindow* window) const;
+
+ private:
+  std::vector<std::pair<StateId, Eigen::VectorXd>> start_;
+};
+
+}  // namespace ctlio::lio

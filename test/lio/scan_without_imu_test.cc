@@ -1,0 +1,76 @@
+// ScanWithoutImu (scan_without_imu.h): which scans it applies to, and that a restore after an
+// implausible estimate removes exactly the scan's lidar blocks and puts back the predicted states.
+// The larger registration budget is checked through the odometry (imu_dropout_test.cc).
+#include "ctlio/solvers/lio/scan_without_imu.h"
+
+#include <gtest/gtest.h>
+
+#include "ctlio/factors/priors/pose_prior.h"
+
+namespace ctlio::lio {
+namespace {
+
+TEST(ScanWithoutImu, AppliesToGpMethodsOnScansWithoutImuResiduals) {
+  ScanResult measured, unmeasured;
+  measured.imu_residuals = 40;
+  unmeasured.imu_residuals = 0;
+  for (LioMethod m : {LioMethod::kSingerLio, LioMethod::kLidarGyro, LioMethod::kLidarOnly}) {
+    EXPECT_TRUE(ScanWithoutImu::Applies(m, unmeasured)) << LioMethodName(m);
+    EXPECT_FALSE(ScanWithoutImu::Applies(m, measured)) << LioMethodName(m);
+  }
+  // The baseline bridges its gaps its own way.
+  EXPECT_FALSE(ScanWithoutImu::Applies(LioMethod::kImuInput, unmeasured));
+}
+
+TEST(ScanWithoutImu, RestoreRemovesTheLidarBlocksAndPutsBackThePrediction) {
+  SlidingWindow window;
+  const SE3 older(SO3::exp(Vec3(0.1, 0.0, 0.2)), Vec3(1, 2, 3));
+  const SE3 predicted(SO3::exp(Vec3(0.0, 0.3, -0.1)), Vec3(4, 5, 6));
+  window.AddPoseState(1, older);
+  window.AddPoseState(2, predicted);
+  window.AddVectorState(3, Eigen::Vector3d(0.5, -0.5, 1.0));
+  const Mat6 I = Mat6::Identity();
+  const ceres::ResidualBlockId kept =
+      window.AddResidualBlock(new PosePrior(older, I), nullptr, {1});
+
+  ScanWithoutImu scan;
+  scan.Begin(true, {2, 3}, window);
+  ASSERT_TRUE(scan.active());
+  RegistrationSummary registered;
+  registered.lidar_blocks.push_back(
+      window.AddResidualBlock(new PosePrior(SE3(SO3(), Vec3(40, 0, 0)), I), nullptr, {2}));
+  window.Solve();  // the "registration" moves the newest pose 40 m away: implausible
+  ASSERT_GT((window.Pose(2).translation() - predicted.translation()).norm(), 30.0);
+  window.State(3)[0] = 7.0;
+
+  ASSERT_TRUE(scan.Restore(registered, &window));
+  EXPECT_EQ(window.num_residual_blocks(), 1);
+  EXPECT_EQ(window.ResidualBlocksOf(1).front(), kept);
+  EXPECT_TRUE(window.ResidualBlocksOf(2).empty());
+  EXPECT_EQ((window.Pose(2).translation() - predicted.translation()).norm(), 0.0);
+  EXPECT_EQ(
+      (window.Pose(2).so3().unit_quaternion().coeffs() - predicted.so3().unit_quaternion().coeffs())
+          .norm(),
+      0.0);
+  EXPECT_EQ(window.Vector(3), Eigen::Vector3d(0.5, -0.5, 1.0));
+  EXPECT_EQ((window.Pose(1).translation() - older.translation()).norm(), 0.0);  // not its state
+}
+
+TEST(ScanWithoutImu, AScanWithImuIsLeftAlone) {
+  SlidingWindow window;
+  window.AddPoseState(2, SE3());
+  ScanWithoutImu scan;
+  scan.Begin(true, {2}, window);
+  scan.Begin(false, {2}, window);  // the next scan has IMU samples: nothing kept from before
+  EXPECT_FALSE(scan.active());
+  RegistrationSummary registered;
+  registered.lidar_blocks.push_back(window.AddResidualBlock(
+      new PosePrior(SE3(SO3(), Vec3(1, 0, 0)), Mat6::Identity()), nullptr, {2}));
+  window.State(2)[0] = 9.0;
+  EXPECT_FALSE(scan.Restore(registered, &window));
+  EXPECT_EQ(window.num_residual_blocks(), 1);
+  EXPECT_EQ(window.State(2)[0], 9.0);
+}
+
+}  // namespace
+}  // namespace ctlio::lio
