@@ -238,6 +238,9 @@ TEST(KnotSpacing, ARunTheRuleNeverTriggersInIsTheFixedCountRunBitForBit) {
   const PipelineRun fixed = RunPipeline(one, sim::Regime::kWalking);
   OdometryConfig adaptive = one;
   adaptive.adaptive_knots = Options(3, 0.15);
+  // Variance floors far above the configured variances: they act on split sweeps only.
+  adaptive.adaptive_knots.accel_variance_floor = 100.0 * one.AccelVariance(0);
+  adaptive.adaptive_knots.gyro_variance_floor = 100.0 * one.GyroVariance(0);
   const PipelineRun run = RunPipeline(adaptive, sim::Regime::kWalking);
   ASSERT_EQ(run.scans.size(), fixed.scans.size());
   for (size_t i = 1; i < run.scans.size(); ++i) {
@@ -252,6 +255,34 @@ TEST(KnotSpacing, ARunTheRuleNeverTriggersInIsTheFixedCountRunBitForBit) {
     EXPECT_GE(fast.expected[i], 2) << "scan " << i << " residual " << fast.residual[i];
     EXPECT_EQ(fast.marginalized[i], fast.expected[i - 1]) << "scan " << i;
   }
+}
+
+// On the sweeps the rule splits, the IMU measurements are whitened with the variance floors: with
+// floors 100× the configured variances the whitened χ² of the IMU blocks at the final estimates
+// falls (the estimate moves away from the down-weighted samples, so by less than 100×: measured
+// gyro 0.37×, accelerometer below 0.1×); a floor that did not reach the blocks would leave it.
+TEST(KnotSpacing, SplitSweepsUseTheVarianceFloors) {
+  OdometryConfig split = testing::SimLioConfig();
+  split.adaptive_knots = Options(2, 1e-6);  // every sweep of the fast sequence split
+  OdometryConfig floored = split;
+  floored.adaptive_knots.accel_variance_floor = 100.0 * split.AccelVariance(0);
+  floored.adaptive_knots.gyro_variance_floor = 100.0 * split.GyroVariance(0);
+  const PipelineRun a = RunPipeline(split, sim::Regime::kFast);
+  const PipelineRun b = RunPipeline(floored, sim::Regime::kFast);
+  ASSERT_EQ(a.scans.size(), b.scans.size());
+  double gyro_a = 0.0, gyro_b = 0.0, accel_a = 0.0, accel_b = 0.0;
+  for (size_t i = 1; i < a.scans.size(); ++i) {
+    ASSERT_EQ(a.expected[i], 2);
+    ASSERT_NE(b.scans[i].status, ScanStatus::kFailed) << "scan " << i;
+    gyro_a += a.scans[i].gyro_chi2;
+    gyro_b += b.scans[i].gyro_chi2;
+    accel_a += a.scans[i].accel_chi2;
+    accel_b += b.scans[i].accel_chi2;
+  }
+  ASSERT_GT(gyro_a, 0.0);
+  ASSERT_GT(accel_a, 0.0);
+  EXPECT_LT(gyro_b, 0.5 * gyro_a);
+  EXPECT_LT(accel_b, 0.1 * accel_a);
 }
 
 }  // namespace
