@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/sim_lio.h"
@@ -137,7 +139,7 @@ TEST(KnotSpacing, TheAccelerometerThresholdAloneCanAskForKnots) {
   EXPECT_EQ(KnotsForSweep(Options(2, 0.15, r * 1.1), 1, t, gyro, accel), 1);
 }
 
-TEST(KnotSpacing, ConfigReadsTheKeysAndRejectsBadValues) {
+TEST(KnotSpacing, ValidateRejectsBadValues) {
   OdometryConfig c;
   EXPECT_FALSE(c.adaptive_knots.enabled(c.knots_per_scan));  // off in code
   c.adaptive_knots = Options(2, 0.15);
@@ -148,6 +150,39 @@ TEST(KnotSpacing, ConfigReadsTheKeysAndRejectsBadValues) {
   EXPECT_THROW(c.Validate(), std::invalid_argument);
   c.adaptive_knots = Options(2, 0.15, std::nan(""));
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+// The YAML keys reach the options; the shipped sensor configs carry the rule (base.yaml), and
+// data/sim_lio.yaml (Table II) does not; a bad value names its key.
+TEST(KnotSpacing, YamlKeysAndTheShippedDefaults) {
+  const std::string path = ::testing::TempDir() + "/adaptive_knots.yaml";
+  std::ofstream(path) << "window:\n  adaptive_knots_max: 3\n  adaptive_knots_gyro_curvature: 0.2\n"
+                         "  adaptive_knots_accel_curvature: 1.5\n"
+                         "  adaptive_knots_accel_variance: 0.3\n"
+                         "  adaptive_knots_gyro_variance: 0.001\n";
+  const AdaptiveKnotOptions o = LoadOdometryConfig(path).adaptive_knots;
+  EXPECT_EQ(o.max_knots_per_scan, 3);
+  EXPECT_EQ(o.gyro_curvature, 0.2);
+  EXPECT_EQ(o.accel_curvature, 1.5);
+  EXPECT_EQ(o.accel_variance_floor, 0.3);
+  EXPECT_EQ(o.gyro_variance_floor, 0.001);
+  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  for (const char* sensor : {"vlp16", "hdl32e", "os1_64", "mid360"}) {
+    const OdometryConfig c = LoadOdometryConfig(data + "sensors/" + sensor + ".yaml");
+    EXPECT_TRUE(c.adaptive_knots.enabled(c.knots_per_scan)) << sensor;
+    EXPECT_EQ(c.adaptive_knots.max_knots_per_scan, 2) << sensor;
+    EXPECT_EQ(c.adaptive_knots.gyro_curvature, 0.15) << sensor;
+  }
+  const OdometryConfig table2 = LoadOdometryConfig(data + "sim_lio.yaml");
+  EXPECT_FALSE(table2.adaptive_knots.enabled(table2.knots_per_scan));
+  std::ofstream(path) << "window:\n  adaptive_knots_gyro_curvature: -0.1\n";
+  try {
+    LoadOdometryConfig(path);
+    ADD_FAILURE() << "a negative threshold was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("adaptive_knots_gyro_curvature"), std::string::npos)
+        << e.what();
+  }
 }
 
 // A short sparse sequence (16 beams, every 8th firing, 1.5 s), as in knots_per_scan_test.
@@ -238,6 +273,9 @@ TEST(KnotSpacing, ARunTheRuleNeverTriggersInIsTheFixedCountRunBitForBit) {
   const PipelineRun fixed = RunPipeline(one, sim::Regime::kWalking);
   OdometryConfig adaptive = one;
   adaptive.adaptive_knots = Options(3, 0.15);
+  // Variance floors far above the configured variances: they act on split sweeps only.
+  adaptive.adaptive_knots.accel_variance_floor = 100.0 * one.AccelVariance(0);
+  adaptive.adaptive_knots.gyro_variance_floor = 100.0 * one.GyroVariance(0);
   const PipelineRun run = RunPipeline(adaptive, sim::Regime::kWalking);
   ASSERT_EQ(run.scans.size(), fixed.scans.size());
   for (size_t i = 1; i < run.scans.size(); ++i) {
@@ -252,6 +290,34 @@ TEST(KnotSpacing, ARunTheRuleNeverTriggersInIsTheFixedCountRunBitForBit) {
     EXPECT_GE(fast.expected[i], 2) << "scan " << i << " residual " << fast.residual[i];
     EXPECT_EQ(fast.marginalized[i], fast.expected[i - 1]) << "scan " << i;
   }
+}
+
+// On the sweeps the rule splits, the IMU measurements are whitened with the variance floors: with
+// floors 100× the configured variances the whitened χ² of the IMU blocks at the final estimates
+// falls (the estimate moves away from the down-weighted samples, so by less than 100×: measured
+// gyro 0.37×, accelerometer below 0.1×); a floor that did not reach the blocks would leave it.
+TEST(KnotSpacing, SplitSweepsUseTheVarianceFloors) {
+  OdometryConfig split = testing::SimLioConfig();
+  split.adaptive_knots = Options(2, 1e-6);  // every sweep of the fast sequence split
+  OdometryConfig floored = split;
+  floored.adaptive_knots.accel_variance_floor = 100.0 * split.AccelVariance(0);
+  floored.adaptive_knots.gyro_variance_floor = 100.0 * split.GyroVariance(0);
+  const PipelineRun a = RunPipeline(split, sim::Regime::kFast);
+  const PipelineRun b = RunPipeline(floored, sim::Regime::kFast);
+  ASSERT_EQ(a.scans.size(), b.scans.size());
+  double gyro_a = 0.0, gyro_b = 0.0, accel_a = 0.0, accel_b = 0.0;
+  for (size_t i = 1; i < a.scans.size(); ++i) {
+    ASSERT_EQ(a.expected[i], 2);
+    ASSERT_NE(b.scans[i].status, ScanStatus::kFailed) << "scan " << i;
+    gyro_a += a.scans[i].gyro_chi2;
+    gyro_b += b.scans[i].gyro_chi2;
+    accel_a += a.scans[i].accel_chi2;
+    accel_b += b.scans[i].accel_chi2;
+  }
+  ASSERT_GT(gyro_a, 0.0);
+  ASSERT_GT(accel_a, 0.0);
+  EXPECT_LT(gyro_b, 0.5 * gyro_a);
+  EXPECT_LT(accel_b, 0.1 * accel_a);
 }
 
 }  // namespace

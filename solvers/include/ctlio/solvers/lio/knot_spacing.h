@@ -3,11 +3,12 @@
 // carries ϖ and ϖ̇ at both ends, so an angular rate that changes linearly over the sweep (constant
 // angular acceleration) is followed, and what it cannot follow is the rate's curvature (angular
 // jerk: handheld shaking at 4–8 Hz). That part is measured here from the sweep's own gyro samples:
-// the RMS of the samples about their least-squares straight line in time, per axis, summed over
-// the axes (the bias and any constant rotation of the mounting drop out of the line fit). For a
-// rate ω(t) with curvature c = ω̈/2 the residual of a line over an interval of length T is
-// |c|·T²/√180, so K equal intervals shrink it by K²: the sweep gets the fewest knots K (from
-// knots_per_scan up to adaptive_knots_max) with r / K² ≤ threshold, r the measured residual.
+// the RMS over the samples of the norm of their residual about the least-squares straight line in
+// time of each axis (the bias drops out of the line fit, and a rotation of the mounting does not
+// change the norm). For a rate ω(t) with curvature c = ω̈/2 the residual of a line over an
+// interval of length T is |c|·T²/√180, so K equal intervals shrink it by K²: the sweep gets the
+// fewest knots K (from knots_per_scan up to adaptive_knots_max) with r / K² ≤ threshold, r the
+// measured residual.
 // A sweep whose residual stays below the threshold keeps knots_per_scan: the estimator's problem
 // is the one of a fixed knot count, bit for bit.
 #pragma once
