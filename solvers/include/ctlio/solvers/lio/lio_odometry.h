@@ -122,10 +122,6 @@ class LioOdometry {
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
-  // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
-  // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
-  void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
-                            ScanResult* result);
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;

@@ -1,0 +1,48 @@
+#include "ctlio/solvers/lio/pose_covariance_report.h"
+
+#include <vector>
+
+#include "ctlio/solvers/lio/pose_covariance.h"
+
+namespace ctlio::lio {
+
+std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
+                                         const RegistrationSummary& registered, LidarTerm* term,
+                                         const Estimator& estimator,
+                                         ceres::ResidualBlockId marginal_prior, const SE3& T_mr,
+                                         AdaptiveNoiseScales* scales, SlidingWindow* window) {
+  const std::vector<ceres::ResidualBlockId>& lidar = registered.lidar_blocks;
+  const StateId pose = estimator.NewestPoseKey();
+  const Mat6 tangent_from_body = estimator.NewestPoseTangentFromBody();
+  if (config.pose_covariance_adaptive) {
+    const ImuTermBlocks& imu = estimator.NewestImuBlocks();
+    double lidar_estimate = 0.0;  // no lidar term: nothing to scale
+    if (!registered.associated.empty()) {
+      // The residuals at the estimate, in metres (the window's are whitened, and a batched
+      // term's rows are not per keypoint).
+      std::vector<double> e;
+      std::vector<Vec3> at;
+      term->BeginRound();
+      for (size_t i = 0; i < registered.associated.size(); ++i) {
+        if (!registered.associated[i]) continue;
+        const PlaneAssociation& a = registered.planes[i];
+        Vec3 q, p_map;
+        term->Locate(i, &q, &p_map);
+        e.push_back(a.weight * a.plane_normal.dot(p_map - a.plane_point));
+        at.push_back(a.plane_point);
+      }
+      const LidarSpread spread = MeasureLidarSpread(e, at, kLidarPlaneCell);
+      const double sigma = config.frontend.point_noise_sigma;
+      lidar_estimate =
+          config.pose_covariance_lidar_neff * spread.effective_variance() / (sigma * sigma);
+    }
+    return scales->Compute(window, pose, lidar_estimate, lidar, imu.accel, imu.gyro, marginal_prior,
+                           T_mr, tangent_from_body);
+  }
+  const double scale = config.pose_covariance_lidar_scale;
+  return scale == 1.0
+             ? PoseCovariance(&window->problem(), window->State(pose), T_mr, tangent_from_body)
+             : ScaledPoseCovariance(*window, pose, lidar, scale, T_mr, tangent_from_body);
+}
+
+}  // namespace ctlio::lio
