@@ -32,7 +32,6 @@ using Form = Batch::Form;
 
 struct Scan {
   std::vector<double> pose, extrinsic, delta;
-  Vec6 twist;
   double anchor = 0.0;
   std::vector<Batch::Point> points;
 };
@@ -42,7 +41,6 @@ Scan RandomScan(std::mt19937& rng, int n, double max_angle, double twist_scale) 
   Scan s;
   s.pose = PoseParameters(RandomPose(rng, max_angle, 10.0));
   s.extrinsic = PoseParameters(RandomPose(rng, max_angle, 0.5));
-  s.twist = RandomVec6(rng, twist_scale);
   s.anchor = 0.02 * u(rng);
   s.delta = {s.anchor + 0.03 * u(rng)};  // ε up to 30 ms
   for (int i = 0; i < n; ++i) {
@@ -50,6 +48,7 @@ Scan RandomScan(std::mt19937& rng, int n, double max_angle, double twist_scale) 
     p.association = RandomAssociation(rng);
     p.point_lidar = 20.0 * Vec3(u(rng), u(rng), u(rng));
     p.deskew = RandomPose(rng, 0.3, 0.3);
+    p.twist = RandomVec6(rng, twist_scale);
     s.points.push_back(p);
   }
   return s;
@@ -74,7 +73,7 @@ std::unique_ptr<PointToPlaneWorldCalibrated> Single(const Scan& s, size_t i, boo
                                                     bool offset) {
   PointToPlaneWorldCalibrated::Geometry g;
   g.deskew = s.points[i].deskew;
-  g.twist = s.twist;
+  g.twist = s.points[i].twist;
   g.offset_anchor = s.anchor;
   return std::make_unique<PointToPlaneWorldCalibrated>(
       s.points[i].association, s.points[i].point_lidar, g, extrinsic, offset,
@@ -86,7 +85,7 @@ TEST(PointToPlaneWorldCalibratedBatch, RowsAreThePerPointResidualsWithoutLoss) {
   for (const bool extrinsic : {false, true}) {
     for (const bool offset : {false, true}) {
       Scan s = RandomScan(rng, 9, M_PI, 2.0);
-      const Batch batch(s.points, s.twist, s.anchor, nullptr, extrinsic, offset,
+      const Batch batch(s.points, s.anchor, nullptr, extrinsic, offset,
                         PoseManifold::Pose(s.extrinsic.data()));
       ASSERT_EQ(batch.num_residuals(), 9);
       const std::vector<double*> blocks = Blocks(&s, extrinsic, offset);
@@ -108,7 +107,7 @@ void CheckJacobians(double max_angle, double twist_scale, uint32_t seed) {
     for (const bool extrinsic : {false, true}) {
       for (const bool offset : {false, true}) {
         Scan s = RandomScan(rng, 5, max_angle, twist_scale);
-        const Batch batch(s.points, s.twist, s.anchor, nullptr, extrinsic, offset,
+        const Batch batch(s.points, s.anchor, nullptr, extrinsic, offset,
                           PoseManifold::Pose(s.extrinsic.data()));
         const std::vector<double*> b = Blocks(&s, extrinsic, offset);
         EXPECT_TRUE(JacobiansMatchNumeric(batch, Manifolds(extrinsic, offset),
@@ -133,7 +132,7 @@ TEST(PointToPlaneWorldCalibratedBatch, JacobiansRotationsNearPi) {
     s.pose = PoseParameters(SE3(so3::Exp((M_PI - 1e-6) * axis), Vec3(1.0, 2.0, 3.0)));
     const Vec3 axis_rl = Vec3(u(rng), u(rng), u(rng)).normalized();
     s.extrinsic = PoseParameters(SE3(so3::Exp((M_PI - 1e-6) * axis_rl), Vec3(0.1, -0.2, 0.3)));
-    const Batch batch(s.points, s.twist, s.anchor, nullptr, true, true);
+    const Batch batch(s.points, s.anchor, nullptr, true, true);
     const std::vector<double*> b = Blocks(&s, true, true);
     EXPECT_TRUE(JacobiansMatchNumeric(batch, Manifolds(true, true),
                                       std::vector<const double*>(b.begin(), b.end())))
@@ -187,7 +186,7 @@ void ExpectSameLinearModel(ceres::LossFunction* loss, uint32_t seed, Form form, 
         singles.push_back(owned.back().get());
       }
       Batch batch(
-          s.points, s.twist, s.anchor,
+          s.points, s.anchor,
           std::shared_ptr<const ceres::LossFunction>(loss, [](const ceres::LossFunction*) {}),
           extrinsic, offset, PoseManifold::Pose(s.extrinsic.data()), form);
       const int w = 6 + (extrinsic ? 6 : 0) + (offset ? 1 : 0);
@@ -233,8 +232,8 @@ TEST(PointToPlaneWorldCalibratedBatch, SquareRootCostOnlyEvaluationCarriesTheCos
   std::mt19937 rng(80);
   Scan s = RandomScan(rng, 40, M_PI, 2.0);
   const auto loss = std::make_shared<const ceres::CauchyLoss>(2.0);
-  const Batch rows(s.points, s.twist, s.anchor, loss, true, true, SE3(), Form::kPointRows);
-  const Batch root(s.points, s.twist, s.anchor, loss, true, true, SE3(), Form::kSquareRoot);
+  const Batch rows(s.points, s.anchor, loss, true, true, SE3(), Form::kPointRows);
+  const Batch root(s.points, s.anchor, loss, true, true, SE3(), Form::kSquareRoot);
   const std::vector<double*> b = Blocks(&s, true, true);
   std::vector<double> r_rows(41), r_root(14, 1.0);
   ASSERT_TRUE(rows.Evaluate(b.data(), r_rows.data(), nullptr));
@@ -246,7 +245,7 @@ TEST(PointToPlaneWorldCalibratedBatch, SquareRootCostOnlyEvaluationCarriesTheCos
 }
 
 TEST(PointToPlaneWorldCalibratedBatch, NoPointsIsAnError) {
-  EXPECT_THROW(Batch({}, Vec6::Zero(), 0.0, nullptr, true, true), std::invalid_argument);
+  EXPECT_THROW(Batch({}, 0.0, nullptr, true, true), std::invalid_argument);
 }
 
 }  // namespace

@@ -56,9 +56,8 @@ TEST(BaselineCalibration, EstimatesTheClockOffsetAndTheExtrinsicFromTheWrongStar
   ASSERT_EQ(cal.time_offset_s.size(), 1u);
   ASSERT_EQ(cal.time_offset_sigma_s.size(), 1u);
   ASSERT_TRUE(cal.has_extrinsic);
-  // Measured here after 4 s: rotation 0.63°, the lever arm 29 cm off (the baseline observes it
-  // weakly and drifts: calibration.md, "In the IMU-as-input baseline"), δ within 5 ms; from 0 ms
-  // and 3° / 10 cm.
+  // After 4 s from 0 ms and 3° / 10 cm: δ and the rotation near the truth; the lever arm, the
+  // slowest coordinate, is not asserted here (docs/experiments/calibration.md).
   EXPECT_NEAR(cal.time_offset_s[0], 0.020, 0.005);
   const sim::ExtrinsicErrorSize end = sim::MeasureExtrinsicError(cal.T_imu_lidar, c.imu_from_lidar);
   EXPECT_LT(end.rotation_deg, 1.0);
@@ -109,6 +108,26 @@ TEST(BaselineCalibration, BatchedResidualsGiveThePerKeypointEstimates) {
     EXPECT_LT(std::abs(ca.time_offset_s[0] - cb.time_offset_s[0]), 1e-6);
     EXPECT_LT(dx.head<3>().norm(), 1e-4);
     EXPECT_LT(dx.tail<3>().norm(), 1e-5);
+  }
+}
+
+// The clock offset in fast motion (tuning index 100, the extrinsic known, δ from 0 against a true
+// 20 ms): it enters the preintegrated factor (its interval moves with δ) and the deskew of every
+// keypoint (point_to_plane_world_calibrated.h). With δ only in the lidar term's carry to the scan
+// end it ran away to −34 ms within 6 s; with the deskew held at the estimate (no derivative) to
+// −8 ms after 1 s. Measured: within 0.1 ms from 0.3 s on.
+TEST(BaselineCalibration, FindsTheClockOffsetInFastMotion) {
+  sim::SimConfig c =
+      testing::WrongCalibrationSequence(sim::Regime::kFast, 2.0, /*imu_stamp_offset_s=*/0.020);
+  c.nominal_imu_from_lidar = c.imu_from_lidar;
+  OdometryConfig config = Baseline(false);
+  config.calibration.estimate_time_offset = true;
+  const std::vector<ScanResult> results = RunSequence(c, config);
+  ASSERT_GE(results.size(), 19u);
+  for (size_t i = 10; i < results.size(); ++i) {  // from 1 s on
+    ASSERT_NE(results[i].status, ScanStatus::kFailed) << results[i].message;
+    ASSERT_EQ(results[i].calibration.time_offset_s.size(), 1u);
+    EXPECT_NEAR(results[i].calibration.time_offset_s[0], 0.020, 0.0005) << "scan " << i;
   }
 }
 

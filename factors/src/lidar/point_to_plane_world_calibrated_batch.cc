@@ -10,11 +10,10 @@
 namespace ctlio {
 
 PointToPlaneWorldCalibratedBatch::PointToPlaneWorldCalibratedBatch(
-    std::vector<Point> points, const Vec6& twist, double offset_anchor,
+    std::vector<Point> points, double offset_anchor,
     std::shared_ptr<const ceres::LossFunction> loss, bool extrinsic_block, bool offset_block,
     const SE3& fixed_T_rl, Form form)
     : points_(std::move(points)),
-      twist_(twist),
       offset_anchor_(offset_anchor),
       loss_(std::move(loss)),
       extrinsic_(extrinsic_block),
@@ -41,7 +40,6 @@ bool PointToPlaneWorldCalibratedBatch::Evaluate(double const* const* parameters,
   const SE3 T_wb = PoseManifold::Pose(parameters[0]);
   const SE3 T_rl = extrinsic_ ? PoseManifold::Pose(parameters[rl_block]) : fixed_T_rl_;
   const double epsilon = offset_ ? offset_anchor_ - parameters[delta_block][0] : 0.0;
-  const SE3 E = SE3::Exp(epsilon * twist_);  // the scan's, once for all points
   bool want = false;
   if (jacobians != nullptr) {
     for (int b = 0; b < static_cast<int>(parameter_block_sizes().size()); ++b) {
@@ -62,8 +60,9 @@ bool PointToPlaneWorldCalibratedBatch::Evaluate(double const* const* parameters,
   double J_delta = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const Point& p = points_[i];
+    const SE3 E = offset_ ? SE3::Exp(epsilon * p.twist) : SE3();
     const double e = PointToPlaneWorldCalibrated::EvaluateTangent(
-        p.association, p.point_lidar, p.deskew, twist_, T_wb, T_rl, E, want ? &J_wb : nullptr,
+        p.association, p.point_lidar, p.deskew, p.twist, T_wb, T_rl, E, want ? &J_wb : nullptr,
         want && extrinsic_ ? &J_rl : nullptr, want && offset_ ? &J_delta : nullptr);
     double scale = 1.0;
     if (loss_ != nullptr) {

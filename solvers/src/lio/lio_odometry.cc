@@ -15,7 +15,7 @@
 #include "ctlio/solvers/lio/gravity_alignment.h"
 #include "ctlio/solvers/lio/imu_consistency.h"
 #include "ctlio/solvers/lio/input_checks.h"
-#include "ctlio/solvers/lio/pose_covariance.h"
+#include "ctlio/solvers/lio/pose_covariance_report.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
 #include "ctlio/solvers/lio/state_keys.h"
 #include "scan_clock.h"
@@ -257,71 +257,14 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map += MsSince(t_map);
   estimator_->Report(result);
-  if (config_.pose_covariance && !restored) ReportPoseCovariance(registered, lidar.get(), result);
-  calibration_.Report(estimator_->NewestKeys(), &window_, result);
-}
-
-void LioOdometry::ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
-                                       ScanResult* result) {
-  const std::vector<ceres::ResidualBlockId>& lidar = registered.lidar_blocks;
-  // window.pose_covariance_adaptive: noise levels from this scan's residuals
-  // (adaptive_covariance.h); else the window as solved, or with a fixed lidar variance scale. Not
-  // the lidar term's plain χ² (LidarChiSquareScale): its spread alone made the baseline 40x
-  // overconfident (docs/experiments/covariance.md). A rank-deficient window gives no covariance.
-  const StateId pose = estimator_->NewestPoseKey();
-  if (config_.pose_covariance_adaptive) {
-    const ImuTermBlocks& imu = estimator_->NewestImuBlocks();
-    double lidar_estimate = 0.0;  // no lidar term: nothing to scale
-    if (!registered.associated.empty()) {
-      // The residuals at the estimate, in metres (the window's are whitened, and a batched
-      // term's rows are not per keypoint).
-      std::vector<double> e;
-      std::vector<Vec3> at;
-      term->BeginRound();
-      for (size_t i = 0; i < registered.associated.size(); ++i) {
-        if (!registered.associated[i]) continue;
-        const PlaneAssociation& a = registered.planes[i];
-        Vec3 q, p_map;
-        term->Locate(i, &q, &p_map);
-        e.push_back(a.weight * a.plane_normal.dot(p_map - a.plane_point));
-        at.push_back(a.plane_point);
-      }
-      const LidarSpread spread = MeasureLidarSpread(e, at, kLidarPlaneCell);
-      const double sigma = config_.frontend.point_noise_sigma;
-      lidar_estimate =
-          config_.pose_covariance_lidar_neff * spread.effective_variance() / (sigma * sigma);
-    }
-    const std::optional<Mat6> S = covariance_scales_.Compute(
-        &window_, pose, lidar_estimate, lidar, imu.accel, imu.gyro, last_marginalization_.prior,
-        result->T_mr, estimator_->NewestPoseTangentFromBody());
-    if (!S) return;
-    result->pose_covariance = *S + MapCovariance();
-    result->has_pose_covariance = true;
-    return;
+  if (config_.pose_covariance && !restored) {
+    const std::optional<Mat6> S = NewestPoseCovariance(config_, registered, lidar.get(),
+                                                       *estimator_, last_marginalization_.prior,
+                                                       result->T_mr, &covariance_models_, &window_);
+    result->has_pose_covariance = S.has_value();
+    if (S) result->pose_covariance = *S;
   }
-  const double scale = config_.pose_covariance_lidar_scale;
-  const double floor_m = config_.pose_covariance_lidar_floor_m;
-  const double floor_rad = config_.pose_covariance_lidar_floor_rad;
-  const std::optional<Mat6> S =
-      floor_m > 0.0 || floor_rad > 0.0
-          ? floored_covariance_.Compute(
-                window_, pose, estimator_->NewestKeys(), lidar, scale,
-                (Vec6() << floor_m, floor_m, floor_m, floor_rad, floor_rad, floor_rad).finished(),
-                result->T_mr, estimator_->NewestPoseTangentFromBody())
-      : scale == 1.0 ? PoseCovariance(&window_.problem(), window_.State(pose), result->T_mr,
-                                      estimator_->NewestPoseTangentFromBody())
-                     : ScaledPoseCovariance(window_, pose, lidar, scale, result->T_mr,
-                                            estimator_->NewestPoseTangentFromBody());
-  if (!S) return;
-  result->pose_covariance = *S + MapCovariance();
-  result->has_pose_covariance = true;
-}
-
-Mat6 LioOdometry::MapCovariance() const {
-  // ε is a left perturbation in the map frame: a rigid map error Exp(m) adds Cov(m) (see
-  // OdometryConfig::pose_covariance_map_sigma_m).
-  const double t = config_.pose_covariance_map_sigma_m, r = config_.pose_covariance_map_sigma_rad;
-  return (Vec6() << t * t, t * t, t * t, r * r, r * r, r * r).finished().asDiagonal();
+  calibration_.Report(estimator_->NewestKeys(), &window_, result);
 }
 
 void LioOdometry::Slide(ScanResult* result) {

@@ -10,6 +10,7 @@
 
 #include "ctlio/factors/gp/vector_prior.h"
 #include "ctlio/factors/imu/preintegrated_imu_factor.h"
+#include "ctlio/factors/imu/preintegrated_imu_time_offset_factor.h"
 #include "ctlio/factors/lidar/point_to_plane_world.h"
 #include "ctlio/factors/lidar/point_to_plane_world_calibrated.h"
 #include "ctlio/factors/lidar/point_to_plane_world_calibrated_batch.h"
@@ -40,9 +41,10 @@ imu::NavState ReadNavState(const NavStateEstimator::State& s) {
 }
 
 // The keypoints deskewed into the body frame at the scan end by the IMU integrated from the
-// previous state's current estimate (re-integrated every round), at the single pose T_wb. With
-// online calibration each keypoint enters from the lidar frame through T_rl, and the state is
-// carried ε = δ̄ − δ along the body twist to the scan end (PointToPlaneWorldCalibrated), the
+// previous state's current estimate (re-integrated every round, at the current clock offset), at
+// the single pose T_wb. With online calibration each keypoint enters from the lidar frame through
+// T_rl and the deskew moves with the clock offset to first order (PointToPlaneWorldCalibrated's
+// per-point twist ξ = Ad(D)·ν(τ) − ν(t_end)), the
 // scan's keypoints batched into one block unless lidar_frontend.residual_blocks is "point"
 // (PointToPlaneWorldCalibratedBatch: ~600 per-keypoint blocks with the calibration states were
 // 93 ms per scan on medium/0, docs/experiments/calibration.md). Without calibration the
@@ -57,13 +59,15 @@ class DeskewedLidarTerm final : public LidarTerm {
         keypoints_(scan.keypoints),
         calibrated_(estimator.config().calibration.any()),
         batched_(calibrated_ && estimator.config().frontend.residual_blocks != "point"),
-        square_root_(estimator.config().frontend.residual_blocks == "square_root") {
+        square_root_(estimator.config().frontend.residual_blocks == "square_root"),
+        offset_(estimator.estimates_time_offset()) {
     if (!calibrated_) return;
     // The lidar-frame points (prepared with the extrinsic estimate of the scan's start).
     const SE3 T_lidar_robot = scan.T_robot_lidar.Inverse();
     q_l_.reserve(keypoints_.size());
     for (const TimedPoint& k : keypoints_) q_l_.push_back(T_lidar_robot * k.point);
     deskew_.resize(keypoints_.size());
+    twist_.resize(keypoints_.size(), Vec6::Zero());
   }
 
   size_t num_keypoints() const override { return keypoints_.size(); }
@@ -72,13 +76,15 @@ class DeskewedLidarTerm final : public LidarTerm {
     T_wb_ = PoseManifold::Pose(s_.pose);
     if (!calibrated_) return;
     T_rl_ = estimator_.Extrinsic();
-    geometry_.twist = table_.EndTwist();
-    geometry_.offset_anchor = s_.offset;
-    T_wb_ = T_wb_ * SE3::Exp((s_.offset - estimator_.TimeOffset()) * geometry_.twist);
+    anchor_ = estimator_.TimeOffset();  // the table's offset
+    end_twist_ = table_.TwistAt(table_.t.empty() ? 0.0 : table_.t.back());
   }
   void Locate(size_t i, Vec3* q, Vec3* p_map) override {
     if (calibrated_) {
       deskew_[i] = table_.T_end_inv * table_.Interpolate(keypoints_[i].time);
+      if (offset_) {
+        twist_[i] = deskew_[i].Adjoint() * table_.TwistAt(keypoints_[i].time) - end_twist_;
+      }
       *q = deskew_[i] * (T_rl_ * q_l_[i]);
     } else {
       *q = table_.ToEnd(keypoints_[i].time, keypoints_[i].point);
@@ -90,12 +96,11 @@ class DeskewedLidarTerm final : public LidarTerm {
     if (calibrated_) {
       if (calibrated_costs_.empty()) calibrated_costs_.resize(keypoints_.size(), nullptr);
       const bool extrinsic = estimator_.estimates_extrinsic();
-      const bool offset = estimator_.estimates_time_offset();
       calibrated_costs_[i] = new PointToPlaneWorldCalibrated(association, q_l_[i], Geometry(i),
-                                                             extrinsic, offset, T_rl_);
+                                                             extrinsic, offset_, T_rl_);
       std::vector<StateId> blocks = {s_.keys.pose};
       if (extrinsic) blocks.push_back(kExtrinsicKey);
-      if (offset) blocks.push_back(TimeOffsetKey(estimator_.config().input_imu));
+      if (offset_) blocks.push_back(TimeOffsetKey(estimator_.config().input_imu));
       return window->AddResidualBlock(calibrated_costs_[i], loss, blocks);
     }
     if (costs_.empty()) costs_.resize(keypoints_.size(), nullptr);
@@ -121,29 +126,29 @@ class DeskewedLidarTerm final : public LidarTerm {
     blocks->clear();
     std::vector<PointToPlaneWorldCalibratedBatch::Point> points;
     for (size_t i = 0; i < keypoints_.size(); ++i) {
-      if (associated[i]) points.push_back({planes[i], q_l_[i], deskew_[i]});
+      if (associated[i]) points.push_back({planes[i], q_l_[i], deskew_[i], twist_[i]});
     }
     if (points.empty()) return;
     const bool extrinsic = estimator_.estimates_extrinsic();
-    const bool offset = estimator_.estimates_time_offset();
     using Form = PointToPlaneWorldCalibratedBatch::Form;
     // W + 1 ≤ 14 rows: the square-root form only for more points than that.
-    const int w = 6 + (extrinsic ? 6 : 0) + (offset ? 1 : 0);
+    const int w = 6 + (extrinsic ? 6 : 0) + (offset_ ? 1 : 0);
     const Form form = square_root_ && static_cast<int>(points.size()) > w + 1 ? Form::kSquareRoot
                                                                               : Form::kPointRows;
-    auto* batch = new PointToPlaneWorldCalibratedBatch(std::move(points), geometry_.twist,
-                                                       geometry_.offset_anchor, loss, extrinsic,
-                                                       offset, T_rl_, form);
+    auto* batch = new PointToPlaneWorldCalibratedBatch(std::move(points), anchor_, loss, extrinsic,
+                                                       offset_, T_rl_, form);
     std::vector<StateId> states = {s_.keys.pose};
     if (extrinsic) states.push_back(kExtrinsicKey);
-    if (offset) states.push_back(TimeOffsetKey(estimator_.config().input_imu));
+    if (offset_) states.push_back(TimeOffsetKey(estimator_.config().input_imu));
     blocks->push_back(window->AddResidualBlock(batch, nullptr, states));
   }
 
  private:
   PointToPlaneWorldCalibrated::Geometry Geometry(size_t i) const {
-    PointToPlaneWorldCalibrated::Geometry g = geometry_;
+    PointToPlaneWorldCalibrated::Geometry g;
     g.deskew = deskew_[i];
+    g.twist = twist_[i];
+    g.offset_anchor = anchor_;
     return g;
   }
 
@@ -151,15 +156,18 @@ class DeskewedLidarTerm final : public LidarTerm {
   NavStateEstimator::State prev_, s_;
   const std::vector<TimedPoint>& keypoints_;
   NavStateEstimator::DeskewTable table_;
-  SE3 T_wb_;  // with calibration: carried to the scan end by Exp(ε·ξ)
+  SE3 T_wb_;
   // Per keypoint: its residual's cost function (owned by the window), for UpdateResidual.
   std::vector<PointToPlaneWorld*> costs_;
-  // Online calibration: the lidar-frame points, this round's T_rl, twist and per-point deskew.
-  const bool calibrated_, batched_, square_root_;
+  // Online calibration: the lidar-frame points, this round's T_rl, offset δ̄ of the deskew, and
+  // per point the deskew and its twist with the offset.
+  const bool calibrated_, batched_, square_root_, offset_;
   std::vector<Vec3> q_l_;
   std::vector<SE3> deskew_;
+  std::vector<Vec6> twist_;
   SE3 T_rl_;
-  PointToPlaneWorldCalibrated::Geometry geometry_;
+  double anchor_ = 0.0;
+  Vec6 end_twist_ = Vec6::Zero();
   std::vector<PointToPlaneWorldCalibrated*> calibrated_costs_;
 };
 
@@ -177,11 +185,14 @@ SE3 NavStateEstimator::DeskewTable::Interpolate(double tau) const {
   return SE3::Exp(s * xi) * T_wb[i];
 }
 
-Vec6 NavStateEstimator::DeskewTable::EndTwist() const {
+Vec6 NavStateEstimator::DeskewTable::TwistAt(double tau) const {
   const size_t n = t.size();
   if (n < 2) return Vec6::Zero();
-  const double dt = std::max(t[n - 1] - t[n - 2], 1e-12);
-  return (T_wb[n - 2].Inverse() * T_wb[n - 1]).Log() / dt;
+  // The segment [t_k, t_k+1] holding τ (the first or last one outside the table).
+  const size_t j =
+      std::clamp<size_t>(std::upper_bound(t.begin(), t.end(), tau) - t.begin(), 1, n - 1);
+  const double dt = std::max(t[j] - t[j - 1], 1e-12);
+  return (T_wb[j - 1].Inverse() * T_wb[j]).Log() / dt;
 }
 
 NavStateEstimator::NavStateEstimator(const OdometryConfig& config, const ImuBuffer& imu)
@@ -232,20 +243,19 @@ std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
   return segments;
 }
 
-NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end,
-                                                            double to_offset) const {
+NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, double t_end) const {
   DeskewTable table;
   const Vec6 bias = Eigen::Map<const Vec6>(from.bias);
   imu::PreintegratedImu pim(bias, InputNoise(config_));
   const imu::NavState start = ReadNavState(from);
-  // On the IMU clock from the state `from` to t_end − to_offset, listed on the lidar clock.
-  const double from_imu = from.t - from.offset;
-  table.t.push_back(from_imu + to_offset);
+  // On the IMU clock over [from.t − δ, t_end − δ], listed on the lidar clock (+δ).
+  const double offset = TimeOffset();
+  table.t.push_back(from.t);
   table.T_wb.push_back(PoseManifold::Pose(from.pose));
-  for (const ImuSegment& seg : InputSegments(from_imu, t_end - to_offset, nullptr)) {
+  for (const ImuSegment& seg : InputSegments(from.t - offset, t_end - offset, nullptr)) {
     pim.Integrate(seg.accel, seg.gyro, seg.dt);
     const imu::NavState x = pim.Predict(start, bias, gravity_map_);
-    table.t.push_back(seg.t_begin + seg.dt + to_offset);
+    table.t.push_back(seg.t_begin + seg.dt + offset);
     table.T_wb.push_back(SE3(x.C, x.p));
   }
   table.T_end_inv = table.T_wb.back().Inverse();
@@ -253,7 +263,7 @@ NavStateEstimator::DeskewTable NavStateEstimator::Integrate(const State& from, d
 }
 
 NavStateEstimator::DeskewTable NavStateEstimator::Deskew(const State& from, const State& to) const {
-  if (!to.after_gap) return Integrate(from, to.t, to.offset);
+  if (!to.after_gap) return Integrate(from, to.t);
   DeskewTable table;
   table.t = {from.t, to.t};
   table.T_wb = {PoseManifold::Pose(from.pose), PoseManifold::Pose(to.pose)};
@@ -285,7 +295,6 @@ void NavStateEstimator::AddStateAcrossGap(const State& prev, double t_end, Slidi
   states_.push_back(AddNavState(t_end, T_pred, v, bias, window));
   State& s = states_.back();
   s.after_gap = true;
-  s.offset = TimeOffset();
   // v_s − v_prev ~ N(0, q·Δt·I): VectorGpPrior with Φ = I (a random walk on the velocity).
   const Mat3 sqrt_info = Mat3::Identity() / std::sqrt(config_.gap_velocity_walk * dt);
   window->AddResidualBlock(new gp::VectorGpPrior<3>(Mat3::Identity(), sqrt_info), nullptr,
@@ -297,7 +306,7 @@ SE3 NavStateEstimator::NewestPose() const { return PoseManifold::Pose(states_.ba
 
 std::vector<SE3> NavStateEstimator::PosesSincePrevious(const std::vector<double>& t) const {
   const State& s = states_.back();
-  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t, s.offset);
+  const DeskewTable table = Integrate(states_[states_.size() - 2], s.t);
   const SE3 T_wb_end = PoseManifold::Pose(s.pose) * table.T_end_inv;
   std::vector<SE3> poses;
   poses.reserve(t.size());
@@ -392,7 +401,6 @@ void NavStateEstimator::Initialise(const PreparedScan& scan, const Mat3& C_mi,
   if (estimates_extrinsic()) AddExtrinsicState(config_, window);
   if (estimates_time_offset()) AddTimeOffsetState(config_.calibration, config_.input_imu, window);
   states_.push_back(AddNavState(scan.t_end, SE3(), Vec3::Zero(), Vec6::Zero(), window));
-  states_.back().offset = TimeOffset();
   const State& s = states_.back();
   window->SetStateConstant(s.keys.pose, true);
   window->SetStateConstant(s.keys.velocity, true);
@@ -404,10 +412,12 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
   imu_blocks_.clear();
   const State prev = states_.back();
   double max_gap = 0.0;
-  // On the IMU clock: from the previous state to this scan's end at the current offset estimate.
+  // On the IMU clock: from the previous state to this scan's end at the current offset estimate
+  // δ̄, the anchor of the interval's first-order shift with δ
+  // (preintegrated_imu_time_offset_factor.h).
   const double offset = TimeOffset();
   const std::vector<ImuSegment> segments =
-      InputSegments(prev.t - prev.offset, scan.t_end - offset, &max_gap);
+      InputSegments(prev.t - offset, scan.t_end - offset, &max_gap);
   if (!config_.gap_zero_order_hold && (segments.empty() || max_gap > config_.gap_hold_max)) {
     AddStateAcrossGap(prev, scan.t_end, window);
     result->imu_residuals = 0;
@@ -422,11 +432,22 @@ void NavStateEstimator::AddState(const PreparedScan& scan, SlidingWindow* window
   for (const ImuSegment& seg : segments) pim.Integrate(seg.accel, seg.gyro, seg.dt);
   const imu::NavState pred = pim.Predict(ReadNavState(prev), bias_hat, gravity_map_);
   states_.push_back(AddNavState(scan.t_end, SE3(pred.C, pred.p), pred.v, bias_hat, window));
-  states_.back().offset = offset;
   const State& s = states_.back();
-  imu_blocks_.accel.push_back(window->AddResidualBlock(
-      new imu::PreintegratedImuFactor(pim, gravity_map_), nullptr,
-      {prev.keys.pose, prev.keys.velocity, prev.keys.bias, s.keys.pose, s.keys.velocity}));
+  std::vector<StateId> blocks = {prev.keys.pose, prev.keys.velocity, prev.keys.bias, s.keys.pose,
+                                 s.keys.velocity};
+  ceres::CostFunction* factor = nullptr;
+  if (estimates_time_offset()) {
+    imu::PreintegrationEnds ends;
+    ends.accel_begin = segments.front().accel;
+    ends.gyro_begin = segments.front().gyro;
+    ends.accel_end = segments.back().accel;
+    ends.gyro_end = segments.back().gyro;
+    factor = new imu::PreintegratedImuTimeOffsetFactor(pim, gravity_map_, ends, offset);
+    blocks.push_back(TimeOffsetKey(config_.input_imu));
+  } else {
+    factor = new imu::PreintegratedImuFactor(pim, gravity_map_);
+  }
+  imu_blocks_.accel.push_back(window->AddResidualBlock(factor, nullptr, blocks));
   window->AddResidualBlock(MakeBiasRandomWalk(config_, s.t - prev.t), nullptr,
                            {prev.keys.bias, s.keys.bias});
   result->imu_residuals = 1;
@@ -441,12 +462,11 @@ std::unique_ptr<LidarTerm> NavStateEstimator::MakeLidarTerm(const PreparedScan& 
 void NavStateEstimator::MapPoints(const PreparedScan& scan, std::vector<Vec3>* out) const {
   const State& s = states_.back();
   const DeskewTable table = Deskew(states_[states_.size() - 2], s);
-  SE3 T_wb = PoseManifold::Pose(s.pose);
+  const SE3 T_wb = PoseManifold::Pose(s.pose);
   out->clear();
   out->reserve(scan.points.size());
   if (config_.calibration.any()) {
-    // The final calibration estimates: the points moved with T_rl, the state to the scan end.
-    T_wb = T_wb * SE3::Exp((s.offset - TimeOffset()) * table.EndTwist());
+    // The final extrinsic estimate: the points moved with T_rl.
     const SE3 recalibrate = Extrinsic() * scan.T_robot_lidar.Inverse();
     for (const TimedPoint& p : scan.points) {
       out->push_back(T_wb * table.ToEnd(p.time, recalibrate * p.point));

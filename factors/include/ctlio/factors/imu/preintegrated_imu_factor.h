@@ -47,4 +47,24 @@ class PreintegratedImuFactor final : public ceres::SizedCostFunction<9, 7, 3, 6,
   Mat9 sqrt_information_;
 };
 
+// The interval moved d seconds earlier on the IMU clock, to first order in d: the
+// bias-corrected deltas become ΔC → Exp(d·rotation)·ΔC, Δv → Δv + d·velocity, Δp → Δp + d·position
+// (preintegrated_imu_time_offset_factor.h derives the rates).
+struct PreintegrationShift {
+  double d = 0.0;
+  Vec3 rotation = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 position = Vec3::Zero();
+};
+
+namespace internal {
+// The residual and Jacobians of PreintegratedImuFactor (this header) on the blocks pose_i, v_i,
+// b_i, pose_j, v_j, with the deltas shifted by `shift` (nullptr: not shifted). d_shift, when not
+// nullptr, receives the 9 whitened derivatives of the residual by `shift->d`.
+bool EvaluatePreintegrated(const PreintegratedImu& pim, const Vec3& gravity,
+                           const Mat9& sqrt_information, const PreintegrationShift* shift,
+                           double const* const* parameters, double* residuals, double** jacobians,
+                           double* d_shift);
+}  // namespace internal
+
 }  // namespace ctlio::imu

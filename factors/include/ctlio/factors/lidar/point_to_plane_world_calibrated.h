@@ -5,11 +5,14 @@
 //   e = w · nᵀ (p_ref − T_wb · Exp(ε·ξ) · D · T_rl · q_l),   ε = δ̄ − δ,
 //
 // q_l: the point in the lidar frame; D: the deskew, from the robot frame at the point's time to
-// the body frame at the state (the IMU integrated from the previous state, held fixed during a
-// solve as the baseline's deskew is); the state sits at IMU-clock time t_end − δ̄ (δ̄: the
-// offset its IMU samples were chosen with), and the scan end t_end on the lidar clock is IMU
-// time t_end − δ, ε = δ̄ − δ later; ξ = [v; ω]: the body twist at the state (fixed like D), so
-// Exp(ε·ξ) carries the state to the scan end (to first order in ε: δ̄ follows δ between scans).
+// the body frame at the state, computed from the IMU at the offset δ̄ (held fixed during a solve,
+// as the baseline's deskew is); ξ = [ρ; φ]: the point's rate of change of its deskew with the
+// offset, Exp(ε·ξ)·D ≈ D(δ) to first order in ε (fixed like D). The IMU-as-input baseline
+// (nav_state_estimator.h) integrates D = T(t_end − δ̄)⁻¹·T(τ − δ̄) on the IMU clock; a later
+// δ = δ̄ − ε moves both ends, T(s − h) = T(s)·Exp(−h·ν(s)) with ν the body twist, so
+//   D(δ) ≈ Exp(−ε·ν(t_end))·D·Exp(ε·ν(τ)) ≈ Exp(ε·(Ad(D)·ν(τ) − ν(t_end)))·D,
+// i.e. ξ = Ad(D)·ν(τ) − ν(t_end): zero under a constant twist, where the offset does not change
+// the deskew.
 //
 // Jacobians, left perturbations as PoseManifold, y = D·T_rl·q_l, z = Exp(ε·ξ)·y, p = T_wb·z:
 //   de/dδ_wb = −w nᵀ [I, −p^]
@@ -32,7 +35,7 @@ class PointToPlaneWorldCalibrated final : public ceres::CostFunction {
   // `plane`: the association (its point_robot unused: the point is q_l through D and T_rl).
   struct Geometry {
     SE3 deskew;                  // D
-    Vec6 twist = Vec6::Zero();   // ξ = [ρ; φ], body frame at the state
+    Vec6 twist = Vec6::Zero();   // ξ = [ρ; φ], body frame at the state (the header's)
     double offset_anchor = 0.0;  // δ̄ [s]
   };
   PointToPlaneWorldCalibrated(const PlaneAssociation& plane, const Vec3& q_lidar,
@@ -56,7 +59,7 @@ class PointToPlaneWorldCalibrated final : public ceres::CostFunction {
     const SE3 T_rl = extrinsic_ ? PoseManifold::Pose(parameters[1]) : fixed_T_rl_;
     const double* delta = offset_ ? parameters[extrinsic_ ? 2 : 1] : nullptr;
     const double epsilon = delta != nullptr ? g_.offset_anchor - delta[0] : 0.0;
-    const SE3 E = SE3::Exp(epsilon * g_.twist);
+    const SE3 E = delta != nullptr ? SE3::Exp(epsilon * g_.twist) : SE3();
     const bool want = jacobians != nullptr;
     Row6 J_wb, J_rl;
     double J_delta = 0.0;

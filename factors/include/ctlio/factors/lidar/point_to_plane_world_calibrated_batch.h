@@ -19,7 +19,7 @@
 // the whole cost in the last row), so the tests compare cost, gradient and JᵀJ with the point
 // rows', and check the point rows' Jacobians against central differences.
 //
-// The twist ξ and anchor δ̄ are the scan's (one navigation state), the deskew D per point.
+// The anchor δ̄ is the scan's (one navigation state), the deskew D and the twist ξ per point.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -40,14 +40,14 @@ class PointToPlaneWorldCalibratedBatch final : public ceres::CostFunction {
   struct Point {
     PlaneAssociation association;  // its point_robot is not read
     Vec3 point_lidar = Vec3::Zero();
-    SE3 deskew;  // D
+    SE3 deskew;                 // D
+    Vec6 twist = Vec6::Zero();  // ξ (PointToPlaneWorldCalibrated::Geometry)
   };
 
-  // At least one point. `loss` (nullable) is each point's robust loss, shared. `twist` and
+  // At least one point. `loss` (nullable) is each point's robust loss, shared.
   // `offset_anchor` as PointToPlaneWorldCalibrated::Geometry's; `fixed_T_rl` is used when the
   // extrinsic is not a block.
-  PointToPlaneWorldCalibratedBatch(std::vector<Point> points, const Vec6& twist,
-                                   double offset_anchor,
+  PointToPlaneWorldCalibratedBatch(std::vector<Point> points, double offset_anchor,
                                    std::shared_ptr<const ceres::LossFunction> loss,
                                    bool extrinsic_block, bool offset_block,
                                    const SE3& fixed_T_rl = SE3(), Form form = Form::kPointRows);
@@ -62,7 +62,6 @@ class PointToPlaneWorldCalibratedBatch final : public ceres::CostFunction {
 
  private:
   std::vector<Point> points_;
-  Vec6 twist_;
   double offset_anchor_;
   std::shared_ptr<const ceres::LossFunction> loss_;
   bool extrinsic_, offset_;

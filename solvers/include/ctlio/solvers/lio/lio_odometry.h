@@ -28,14 +28,13 @@
 #include <utility>
 #include <vector>
 
-#include "ctlio/solvers/lio/adaptive_covariance.h"
 #include "ctlio/solvers/lio/calibration_states.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/final_trajectory.h"
 #include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/imu_buffer.h"
-#include "ctlio/solvers/lio/lidar_floor_covariance.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/lio/pose_covariance_report.h"
 #include "ctlio/solvers/lio/scan_registration.h"
 #include "ctlio/solvers/lio/scan_without_imu.h"
 #include "ctlio/solvers/sliding_window.h"
@@ -124,12 +123,6 @@ class LioOdometry {
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
-  // With config.pose_covariance: Σ of the newest pose into the result (left perturbation of T_mr).
-  // `lidar`: the newest scan's lidar residual blocks (window.pose_covariance_lidar_scale).
-  void ReportPoseCovariance(const RegistrationSummary& registered, LidarTerm* term,
-                            ScanResult* result);
-  // Σ_map of OdometryConfig::pose_covariance_map_sigma_m/_rad (ε convention).
-  Mat6 MapCovariance() const;
   // False (and the scan failed) if the newest pose jumped implausibly far.
   bool EstimatePlausible(ScanResult* result) const;
   void ReportDegenerate(ScanResult* result) const;
@@ -162,8 +155,7 @@ class LioOdometry {
   bool initialised_ = false;
   std::deque<ScanResult> results_;
   MarginalizationReport last_marginalization_;
-  AdaptiveNoiseScales covariance_scales_;     // window.pose_covariance_adaptive
-  FlooredPoseCovariance floored_covariance_;  // window.pose_covariance_lidar_floor_*
+  PoseCovarianceModels covariance_models_;  // their state across scans
   CalibrationStates calibration_;
   ScanWithoutImu without_imu_;  // lidar_only, or a scan in an IMU outage
   int num_marginalizations_ = 0;
