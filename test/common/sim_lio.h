@@ -34,6 +34,16 @@ inline lio::OdometryConfig SimLioConfig() {
   return config;
 }
 
+// 1.5 s of `regime` at tuning index 100, 16 beams, every 8th firing: the knot-count tests'
+// sequence (a fast one splits sweeps, a walk does not).
+inline sim::SimConfig ShortSequenceAtIndex100(sim::Regime regime) {
+  sim::SimConfig c = sim::ExperimentConfig(regime, 100);
+  c.duration_s = 1.5;
+  c.lidar.beams = 16;
+  c.lidar.firing_decimation = 8;
+  return c;
+}
+
 // A short sparse sequence for pipeline tests: 1 s of medium motion (index 0), 16 beams, every 8th
 // firing: enough scans to fill and slide the window in a second or two of test time.
 inline sim::SimConfig ShortSparseSequence() {

@@ -185,15 +185,6 @@ TEST(KnotSpacing, YamlKeysAndTheShippedDefaults) {
   }
 }
 
-// A short sparse sequence (16 beams, every 8th firing, 1.5 s), as in knots_per_scan_test.
-sim::SimConfig ShortSequence(sim::Regime regime) {
-  sim::SimConfig c = sim::ExperimentConfig(regime, 100);
-  c.duration_s = 1.5;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 8;
-  return c;
-}
-
 struct PipelineRun {
   std::vector<ScanResult> scans;
   std::vector<int> marginalized;  // knots that left the window while each scan was processed
@@ -203,7 +194,7 @@ struct PipelineRun {
 };
 
 PipelineRun RunPipeline(const OdometryConfig& config, sim::Regime regime) {
-  sim::SimulatedSource source(ShortSequence(regime));
+  sim::SimulatedSource source(testing::ShortSequenceAtIndex100(regime));
   auto odometry = MakeLioOdometry(config);
   io::ScanFrame f;
   PipelineRun run;

@@ -90,14 +90,6 @@ TEST(KnotsPerScan, RejectsFewerThanTwoKnotsAndTimesThatDoNotIncrease) {
       std::invalid_argument);
 }
 
-sim::SimConfig ShortSequence(sim::Regime regime) {
-  sim::SimConfig c = sim::ExperimentConfig(regime, 100);
-  c.duration_s = 1.5;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 8;
-  return c;
-}
-
 struct PipelineRun {
   std::vector<ScanResult> scans;
   int marginalizations = 0;
@@ -105,7 +97,7 @@ struct PipelineRun {
 };
 
 PipelineRun RunPipeline(const OdometryConfig& config, sim::Regime regime) {
-  sim::SimulatedSource source(ShortSequence(regime));
+  sim::SimulatedSource source(testing::ShortSequenceAtIndex100(regime));
   auto odometry = MakeLioOdometry(config);
   io::ScanFrame f;
   PipelineRun run;
@@ -170,10 +162,10 @@ TEST(KnotsPerScan, TimeOffsetSamplesFollowOnAcrossTheIntervals) {
 // far from a wrong-knot read, and it is the more accurate one (ATE 1.9 against 2.1 cm).
 TEST(KnotsPerScan, TracksAFastSequenceWithASmoothDenseTrajectory) {
   OdometryConfig config = testing::SimLioConfig();
-  sim::SimulatedSource one_source(ShortSequence(sim::Regime::kFast));
+  sim::SimulatedSource one_source(testing::ShortSequenceAtIndex100(sim::Regime::kFast));
   const lioapp::RunSummary one = lioapp::RunOdometry(one_source, config);
   config.knots_per_scan = 2;
-  sim::SimulatedSource source(ShortSequence(sim::Regime::kFast));
+  sim::SimulatedSource source(testing::ShortSequenceAtIndex100(sim::Regime::kFast));
   lioapp::RunOptions options;
   options.trajectory_rate_hz = 100.0;
   const lioapp::RunSummary run = lioapp::RunOdometry(source, config, options);

@@ -53,6 +53,7 @@ struct Layout {
   int n = 0;
   std::set<ceres::ResidualBlockId> blocks;                        // every block of the window
   std::map<ceres::ResidualBlockId, std::set<StateId>> states_of;  // its non-constant states
+  int pose_offset = 0;                                            // of the newest pose
 };
 
 Layout WindowLayout(const SlidingWindow& window) {
@@ -70,6 +71,18 @@ Layout WindowLayout(const SlidingWindow& window) {
   return l;
 }
 
+// The layout of the window's free states and its blocks but the scan's lidar ones; empty if the
+// newest pose is not a free 6-dof state.
+std::optional<Layout> LayoutWithoutLidar(const SlidingWindow& window, StateId pose,
+                                         const std::vector<ceres::ResidualBlockId>& lidar) {
+  Layout l = WindowLayout(window);
+  const auto at = l.offset.find(pose);
+  if (at == l.offset.end() || window.TangentSize(pose) != 6) return std::nullopt;
+  l.pose_offset = at->second;
+  for (const ceres::ResidualBlockId r : lidar) l.blocks.erase(r);
+  return l;
+}
+
 std::optional<Mat6> NewestPose(const Eigen::LDLT<Eigen::MatrixXd>& ldlt, int n, int offset,
                                const SE3& T_mr, const Mat6& tangent_from_body) {
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n, 6);
@@ -84,15 +97,15 @@ std::optional<Mat6> FlooredLidarPoseCovariance(const SlidingWindow& window, Stat
                                                const std::vector<ceres::ResidualBlockId>& lidar,
                                                double lidar_scale, const Vec6& floor_sigma,
                                                const SE3& T_mr, const Mat6& tangent_from_body) {
-  Layout l = WindowLayout(window);
-  const auto at = l.offset.find(pose);
-  if (at == l.offset.end() || window.TangentSize(pose) != 6) return std::nullopt;
-  for (const ceres::ResidualBlockId r : lidar) l.blocks.erase(r);
-  const Eigen::MatrixXd H = FlooredInformationMatrix(
-      window, l.ordering, l.blocks, at->second, lidar, lidar_scale, floor_sigma, tangent_from_body);
+  std::optional<Layout> layout = LayoutWithoutLidar(window, pose, lidar);
+  if (!layout) return std::nullopt;
+  Layout& l = *layout;
+  const Eigen::MatrixXd H =
+      FlooredInformationMatrix(window, l.ordering, l.blocks, l.pose_offset, lidar, lidar_scale,
+                               floor_sigma, tangent_from_body);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
-  return NewestPose(ldlt, l.n, at->second, T_mr, tangent_from_body);
+  return NewestPose(ldlt, l.n, l.pose_offset, T_mr, tangent_from_body);
 }
 
 std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, StateId pose,
@@ -100,10 +113,9 @@ std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, 
                                                    const std::vector<ceres::ResidualBlockId>& lidar,
                                                    double lidar_scale, const Vec6& floor_sigma,
                                                    const SE3& T_mr, const Mat6& tangent_from_body) {
-  Layout l = WindowLayout(window);
-  const auto at = l.offset.find(pose);
-  if (at == l.offset.end() || window.TangentSize(pose) != 6) return std::nullopt;
-  for (const ceres::ResidualBlockId r : lidar) l.blocks.erase(r);
+  std::optional<Layout> layout = LayoutWithoutLidar(window, pose, lidar);
+  if (!layout) return std::nullopt;
+  Layout& l = *layout;
   // The carried prior applies when all its states are still free in the window and the newest
   // pose is not among them; every block on those states alone is then already in it.
   used_carried_ = !carried_states_.empty() && l.offset.count(pose) > 0;
@@ -118,7 +130,7 @@ std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, 
       it = inside ? l.blocks.erase(it) : std::next(it);
     }
   }
-  Eigen::MatrixXd H = FlooredInformationMatrix(window, l.ordering, l.blocks, at->second, lidar,
+  Eigen::MatrixXd H = FlooredInformationMatrix(window, l.ordering, l.blocks, l.pose_offset, lidar,
                                                lidar_scale, floor_sigma, tangent_from_body);
   if (used_carried_) {
     int i0 = 0;
@@ -161,7 +173,7 @@ std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, 
   } else {
     carried_states_.clear();
   }
-  return NewestPose(ldlt, l.n, at->second, T_mr, tangent_from_body);
+  return NewestPose(ldlt, l.n, l.pose_offset, T_mr, tangent_from_body);
 }
 
 }  // namespace ctlio::lio
