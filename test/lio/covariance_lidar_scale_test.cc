@@ -21,10 +21,7 @@ double MinEigenvalue(const Mat6& A) {
 
 lioapp::RunSummary RunWithScale(LioMethod m, double scale, bool adaptive = false,
                                 double floor_m = 0.0, double floor_rad = 0.0) {
-  sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
-  c.duration_s = 1.0;
-  c.lidar.beams = 16;
-  c.lidar.firing_decimation = 8;
+  const sim::SimConfig c = testing::ShortSparseSequence();
   OdometryConfig config = testing::SimLioConfig();
   config.method = m;
   config.pose_covariance = true;
@@ -124,10 +121,7 @@ TEST(CovarianceLidarFloor, SameEstimateOwnCovariance) {
 // (a left perturbation in the map frame), for both methods; the estimates bit for bit.
 TEST(CovarianceMapError, AddsTheMapCovariance) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
-    sim::SimConfig c = sim::ExperimentConfig(sim::Regime::kMedium, 0);
-    c.duration_s = 1.0;
-    c.lidar.beams = 16;
-    c.lidar.firing_decimation = 8;
+    const sim::SimConfig c = testing::ShortSparseSequence();
     OdometryConfig config = testing::SimLioConfig();
     config.method = m;
     config.pose_covariance = true;
