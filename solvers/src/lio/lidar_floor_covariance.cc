@@ -118,7 +118,7 @@ std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, 
   Layout& l = *layout;
   // The carried prior applies when all its states are still free in the window and the newest
   // pose is not among them; every block on those states alone is then already in it.
-  used_carried_ = !carried_states_.empty() && l.offset.count(pose) > 0;
+  used_carried_ = !carried_states_.empty();  // the newest pose is free: LayoutWithoutLidar
   for (const StateId id : carried_states_) {
     if (l.offset.count(id) == 0 || id == pose) used_carried_ = false;
   }
