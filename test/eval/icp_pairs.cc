@@ -4,13 +4,17 @@
 // the error of the converged pose against the reference is printed.
 //
 //   icp_pairs real <graph.txt> <sweep 0> <sweep 1> ...   (float32 x y z files; a+b joins two)
+// ICP_ALL_PAIRS=1 registers every pair i < j (non-adjacent keyframes: larger spacings), not only
+// the consecutive ones; ICP_AXES=1 prints each pair's true rotation and its error per axis.
 //   icp_pairs sim <preset> <world> <world_seed> <index> <first scan> <gap> <pairs> [deskew]
 // With `deskew` the simulated sweeps are first motion-corrected with the ground truth into the
 // lidar frame at the middle of the sweep (as the real Newer College sweeps and features are).
 // Environment: ICP_NO_EFFECTS=1 (the preset without its sensor effects), ICP_EFFECT_ONLY=angles|
 // range|footprint|mixed|grazing (one effect alone), ICP_FEATURES=1 (LOAM-like features of each
 // sweep instead of all its points, as the real Newer College pairs are), ICP_EFFECT_DROP=a,b (the
-// preset's effects without these).
+// preset's effects without these), ICP_SHAKE_SCALE=s (as below), ICP_RELIEF=m / ICP_GRASS_RELIEF=m
+// (the quad's and town's ground micro-relief), ICP_GROUND_CHECK=1 (no registration: the slope of
+// each sweep's ground, deskewed with the truth, against the truth's vertical).
 //
 //   icp_pairs seq <preset> <world> <world_seed> <index> <first scan> <scans> <window> [nodeskew]
 // runs the point-to-point odometry (point_odometry.h: constant-velocity prediction and deskew,
@@ -22,7 +26,10 @@
 // effects), ICP_TRUE_DESKEW=1 (sweeps deskewed with the truth), ICP_MAP_VOXEL=v (map voxel v,
 // registration points 1.5·v), ICP_SHAKE_SCALE=s (the walk's or drive's fast rotations × s),
 // ICP_TRUTH_ONLY=1 (only the truth's constant-velocity model error), ICP_VERBOSE=1 (per sweep),
-// ICP_NO_NOISE=1 (no range noise), ICP_MIN_RANGE=r (points nearer than r [m] dropped; 1 m).
+// ICP_NO_NOISE=1 (no range noise), ICP_MIN_RANGE=r (points nearer than r [m] dropped; 1 m),
+// ICP_STRIDE=s (every s-th sweep only: s times the step per registration), ICP_ABS=1 (the pose
+// error of every sweep), ICP_MAX_POINTS=n (points per map voxel), ICP_MAX_RANGE=r (range and map
+// radius), ICP_CONVERGED=c (the ICP's stopping step).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -89,6 +96,15 @@ void Pair(const std::string& label, const std::vector<Vec3>& target,
   const double et = e.translation().norm(), er = e.Log().tail<3>().norm() * 180.0 / M_PI;
   std::printf("%-36s distance %6.2f m  error %6.3f m  %5.2f deg  (%d correspondences)\n",
               label.c_str(), truth.translation().norm(), et, er, r.correspondences);
+  if (std::getenv("ICP_AXES")) {
+    const Vec6 l = e.Log();
+    const Vec6 lt = truth.Log();
+    std::printf("  true rot %+.3f %+.3f %+.3f deg", lt(3) * 180 / M_PI, lt(4) * 180 / M_PI,
+                lt(5) * 180 / M_PI);
+    std::printf("  axes: t %+.3f %+.3f %+.3f m  r %+.3f %+.3f %+.3f deg\n", e.translation().x(),
+                e.translation().y(), e.translation().z(), l(3) * 180 / M_PI, l(4) * 180 / M_PI,
+                l(5) * 180 / M_PI);
+  }
   total_t += et;
   total_r += er;
   total_d += truth.translation().norm();
@@ -111,10 +127,19 @@ int main(int argc, char** argv) {
           poses.push_back(SE3(Eigen::Quaterniond(qw, qx, qy, qz), Vec3(x, y, z)));
         }
       }
-      for (int k = 3; k + 1 < argc && k - 2 < int(poses.size()); ++k) {
-        const SE3 truth = poses[k - 3].Inverse() * poses[k - 2];
-        Pair(std::string(argv[k + 1]).substr(std::string(argv[k + 1]).find_last_of('/') + 1),
-             ReadSweep(argv[k]), ReadSweep(argv[k + 1]), truth);
+      // ICP_ALL_PAIRS=1: every pair i < j, not only the consecutive ones (non-adjacent pairs at
+      // larger spacings).
+      const bool all = std::getenv("ICP_ALL_PAIRS") != nullptr;
+      const int sweeps = std::min(argc - 3, int(poses.size()));
+      for (int i = 0; i + 1 < sweeps; ++i) {
+        for (int j = i + 1; j < (all ? sweeps : i + 2); ++j) {
+          const auto name = [&](int a) {
+            const std::string f = argv[3 + a];
+            return f.substr(f.find_last_of('/') + 1);
+          };
+          Pair(name(i) + " -> " + name(j), ReadSweep(argv[3 + i]), ReadSweep(argv[3 + j]),
+               poses[i].Inverse() * poses[j]);
+        }
       }
     } else if (mode == "sim" && (argc == 9 || (argc == 10 && std::string(argv[9]) == "deskew"))) {
       const bool deskew = argc == 10;
@@ -157,6 +182,18 @@ int main(int argc, char** argv) {
       const bool features = std::getenv("ICP_FEATURES") != nullptr;
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
+      if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
+        sim::GuideProfile& g = c.motion.guide;
+        g.pitch.amplitude *= std::atof(m);
+        g.roll.amplitude *= std::atof(m);
+        g.yaw_fast.amplitude *= std::atof(m);
+      }
+      if (const char* r = std::getenv("ICP_RELIEF")) {
+        c.world.town.vegetation.relief = c.world.quad.vegetation.relief = std::atof(r);
+      }
+      if (const char* r = std::getenv("ICP_GRASS_RELIEF")) {
+        c.world.town.vegetation.grass_relief = c.world.quad.vegetation.grass_relief = std::atof(r);
+      }
       const int first = std::stoi(argv[6]), gap = std::stoi(argv[7]), n = std::stoi(argv[8]);
       c.duration_s = 0.1 * (first + gap * n + 2);
       c.integration_step_s = 1e-3;
@@ -176,6 +213,35 @@ int main(int argc, char** argv) {
         for (const size_t i : LoamLikeFeatures(c)) kept.push_back(c.points[i]);
         return kept;
       };
+      if (std::getenv("ICP_GROUND_CHECK")) {
+        for (int j = 0; j < n; ++j) {
+          const int k = first + j * gap;
+          const io::PointCloud cl = sim.Scan(k);
+          // Least squares z = a + b x + c y over the ground points in the lidar frame at mid.
+          Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+          Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+          double zmax = 0.0;
+          int cnt = 0;
+          for (size_t i = 0; i < cl.size(); ++i) {
+            const Vec3 w = sim.WorldFromLidar(sim.Seconds(cl.times_ns[i])) * cl.points[i];
+            if (std::abs(w.z()) > 0.2 || cl.points[i].norm() > 30.0) continue;
+            zmax = std::max(zmax, std::abs(w.z()));
+            const Vec3 l = pose(k).Inverse() * w;
+            const Eigen::Vector3d r(1.0, l.x(), l.y());
+            A += r * r.transpose();
+            rhs += r * l.z();
+            ++cnt;
+          }
+          const Eigen::Vector3d x = A.ldlt().solve(rhs);
+          const SE3 T = pose(k);
+          const Vec3 up = T.rotation().transpose() * Vec3(0, 0, 1);
+          std::printf(
+              "sweep %d: %d ground points, max |z_world| %.4f m; lidar-frame plane slope x %.5f y "
+              "%.5f; truth's up in lidar frame slope %.5f %.5f\n",
+              k, cnt, zmax, x(1), x(2), -up.x() / up.z(), -up.y() / up.z());
+        }
+        return 0;
+      }
       for (int j = 0; j < n; ++j) {
         const int a = first + j * gap, b = a + gap;
         Pair(std::string(argv[3]) + " sweeps " + std::to_string(a) + "-" + std::to_string(b),
@@ -188,6 +254,12 @@ int main(int argc, char** argv) {
                                            sim::kExperimentSeed, overrides);
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
+      if (const char* r = std::getenv("ICP_RELIEF")) {
+        c.world.town.vegetation.relief = c.world.quad.vegetation.relief = std::atof(r);
+      }
+      if (const char* r = std::getenv("ICP_GRASS_RELIEF")) {
+        c.world.town.vegetation.grass_relief = c.world.quad.vegetation.grass_relief = std::atof(r);
+      }
       if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
         // The guided motion's fast rotations (pitch, roll, fast yaw) scaled, to ask how much of
         // the drift they cause.
@@ -197,14 +269,15 @@ int main(int argc, char** argv) {
         g.yaw_fast.amplitude *= std::atof(m);
       }
       const int first = std::stoi(argv[6]), n = std::stoi(argv[7]), window = std::stoi(argv[8]);
-      c.duration_s = 0.1 * (first + n + 2);
+      const int stride = std::getenv("ICP_STRIDE") ? std::atoi(std::getenv("ICP_STRIDE")) : 1;
+      c.duration_s = 0.1 * (first + n * stride + 2);
       c.integration_step_s = 1e-3;
       if (std::getenv("ICP_NO_NOISE")) c.lidar.range_noise = 0.0;  // with ICP_NO_EFFECTS: ideal
       const sim::LidarInertialSim sim(c);
       const double period = 1.0 / c.lidar.rate_hz;
       auto mid = [&](int k) { return sim.Seconds(sim.ScanStartNs(k)) + 0.5 * period; };
       std::vector<SE3> truth;
-      for (int k = first; k < first + n; ++k) truth.push_back(sim.WorldFromLidar(mid(k)));
+      for (int j = 0; j < n; ++j) truth.push_back(sim.WorldFromLidar(mid(first + j * stride)));
       // The constant-velocity model's error on the truth itself: δ(D) of point_odometry.h for
       // D = (T_{k−1}·Δ_{k−1})⁻¹·T_k, as the RMS over the sequence (the σ an exact registration
       // would give the adaptive threshold, min_motion aside).
@@ -223,6 +296,11 @@ int main(int argc, char** argv) {
       options.max_range = std::min(100.0, c.lidar.max_range);
       if (const char* s = std::getenv("ICP_FIXED_SIGMA")) options.fixed_sigma = std::atof(s);
       if (const char* s = std::getenv("ICP_MIN_RANGE")) options.min_range = std::atof(s);
+      if (const char* s = std::getenv("ICP_MAX_POINTS"))
+        options.max_points_per_voxel = std::atoi(s);
+      if (const char* s = std::getenv("ICP_CONVERGED")) options.converged = std::atof(s);
+      if (const char* s = std::getenv("ICP_MAX_RANGE"))
+        options.max_range = options.map_radius = std::atof(s);
       const bool true_deskew = std::getenv("ICP_TRUE_DESKEW") != nullptr;
       if (true_deskew) options.deskew = false;
       if (const char* s = std::getenv("ICP_MAP_VOXEL")) {
@@ -233,7 +311,8 @@ int main(int argc, char** argv) {
       // constant velocity (the odometry cannot know it from one sweep).
       eval::PointOdometry odometry(truth.front(), options, truth[0].Inverse() * truth[1]);
       double cpu = 0.0;
-      for (int k = first; k < first + n; ++k) {
+      for (int jj = 0; jj < n; ++jj) {
+        const int k = first + jj * stride;
         io::PointCloud cloud = sim.Scan(k);
         std::vector<double> times(cloud.size());
         for (size_t i = 0; i < cloud.size(); ++i)
@@ -247,11 +326,17 @@ int main(int argc, char** argv) {
           }
         }
         const std::clock_t c0 = std::clock();
-        const SE3 est = odometry.Register(cloud.points, times, period);
+        const SE3 est = odometry.Register(cloud.points, times, std::max(stride, 1) * period);
+        if (std::getenv("ICP_ABS")) {
+          const SE3 e = truth[jj].Inverse() * est;
+          std::printf("abs %d: %+.3f %+.3f %+.3f m %+.3f %+.3f %+.3f deg\n", k, e.translation().x(),
+                      e.translation().y(), e.translation().z(), e.Log()(3) * 57.3,
+                      e.Log()(4) * 57.3, e.Log()(5) * 57.3);
+        }
         cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
         if (std::getenv("ICP_VERBOSE")) {
           // Relative to the previous sweep, in the truth's lidar frame.
-          const int j = k - first;
+          const int j = jj;
           const std::vector<SE3>& e = odometry.poses();
           const SE3 d =
               j == 0 ? SE3()
