@@ -84,6 +84,24 @@ std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c) {
   return keep;
 }
 
+// The world and motion overrides both simulated modes read: ICP_SHAKE_SCALE (the guided motion's
+// fast rotations, pitch, roll and fast yaw, scaled: how much of an error they cause),
+// ICP_RELIEF and ICP_GRASS_RELIEF (the quad's and town's ground micro-relief [m]).
+void ApplyWorldOverrides(sim::SimConfig* c) {
+  if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
+    sim::GuideProfile& g = c->motion.guide;
+    g.pitch.amplitude *= std::atof(m);
+    g.roll.amplitude *= std::atof(m);
+    g.yaw_fast.amplitude *= std::atof(m);
+  }
+  if (const char* r = std::getenv("ICP_RELIEF")) {
+    c->world.town.vegetation.relief = c->world.quad.vegetation.relief = std::atof(r);
+  }
+  if (const char* r = std::getenv("ICP_GRASS_RELIEF")) {
+    c->world.town.vegetation.grass_relief = c->world.quad.vegetation.grass_relief = std::atof(r);
+  }
+}
+
 double total_t = 0.0, total_r = 0.0, total_d = 0.0;
 int pairs = 0;
 
@@ -182,18 +200,7 @@ int main(int argc, char** argv) {
       const bool features = std::getenv("ICP_FEATURES") != nullptr;
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
-      if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
-        sim::GuideProfile& g = c.motion.guide;
-        g.pitch.amplitude *= std::atof(m);
-        g.roll.amplitude *= std::atof(m);
-        g.yaw_fast.amplitude *= std::atof(m);
-      }
-      if (const char* r = std::getenv("ICP_RELIEF")) {
-        c.world.town.vegetation.relief = c.world.quad.vegetation.relief = std::atof(r);
-      }
-      if (const char* r = std::getenv("ICP_GRASS_RELIEF")) {
-        c.world.town.vegetation.grass_relief = c.world.quad.vegetation.grass_relief = std::atof(r);
-      }
+      ApplyWorldOverrides(&c);
       const int first = std::stoi(argv[6]), gap = std::stoi(argv[7]), n = std::stoi(argv[8]);
       c.duration_s = 0.1 * (first + gap * n + 2);
       c.integration_step_s = 1e-3;
@@ -254,22 +261,10 @@ int main(int argc, char** argv) {
                                            sim::kExperimentSeed, overrides);
       c.world.kind = sim::ParseWorld(argv[3]);
       c.world.seed = std::stoull(argv[4]);
-      if (const char* r = std::getenv("ICP_RELIEF")) {
-        c.world.town.vegetation.relief = c.world.quad.vegetation.relief = std::atof(r);
-      }
-      if (const char* r = std::getenv("ICP_GRASS_RELIEF")) {
-        c.world.town.vegetation.grass_relief = c.world.quad.vegetation.grass_relief = std::atof(r);
-      }
-      if (const char* m = std::getenv("ICP_SHAKE_SCALE")) {
-        // The guided motion's fast rotations (pitch, roll, fast yaw) scaled, to ask how much of
-        // the drift they cause.
-        sim::GuideProfile& g = c.motion.guide;
-        g.pitch.amplitude *= std::atof(m);
-        g.roll.amplitude *= std::atof(m);
-        g.yaw_fast.amplitude *= std::atof(m);
-      }
+      ApplyWorldOverrides(&c);
       const int first = std::stoi(argv[6]), n = std::stoi(argv[7]), window = std::stoi(argv[8]);
       const int stride = std::getenv("ICP_STRIDE") ? std::atoi(std::getenv("ICP_STRIDE")) : 1;
+      if (stride < 1) throw std::invalid_argument("ICP_STRIDE must be a positive integer");
       c.duration_s = 0.1 * (first + n * stride + 2);
       c.integration_step_s = 1e-3;
       if (std::getenv("ICP_NO_NOISE")) c.lidar.range_noise = 0.0;  // with ICP_NO_EFFECTS: ideal
@@ -311,8 +306,8 @@ int main(int argc, char** argv) {
       // constant velocity (the odometry cannot know it from one sweep).
       eval::PointOdometry odometry(truth.front(), options, truth[0].Inverse() * truth[1]);
       double cpu = 0.0;
-      for (int jj = 0; jj < n; ++jj) {
-        const int k = first + jj * stride;
+      for (int j = 0; j < n; ++j) {
+        const int k = first + j * stride;
         io::PointCloud cloud = sim.Scan(k);
         std::vector<double> times(cloud.size());
         for (size_t i = 0; i < cloud.size(); ++i)
@@ -326,17 +321,16 @@ int main(int argc, char** argv) {
           }
         }
         const std::clock_t c0 = std::clock();
-        const SE3 est = odometry.Register(cloud.points, times, std::max(stride, 1) * period);
-        if (std::getenv("ICP_ABS")) {
-          const SE3 e = truth[jj].Inverse() * est;
-          std::printf("abs %d: %+.3f %+.3f %+.3f m %+.3f %+.3f %+.3f deg\n", k, e.translation().x(),
-                      e.translation().y(), e.translation().z(), e.Log()(3) * 57.3,
-                      e.Log()(4) * 57.3, e.Log()(5) * 57.3);
-        }
+        const SE3 est = odometry.Register(cloud.points, times, stride * period);
         cpu += double(std::clock() - c0) / CLOCKS_PER_SEC;
+        if (std::getenv("ICP_ABS")) {
+          const SE3 e = truth[j].Inverse() * est;
+          const Vec3 r = e.Log().tail<3>() * 180.0 / M_PI;
+          std::printf("abs %d: %+.3f %+.3f %+.3f m %+.3f %+.3f %+.3f deg\n", k, e.translation().x(),
+                      e.translation().y(), e.translation().z(), r.x(), r.y(), r.z());
+        }
         if (std::getenv("ICP_VERBOSE")) {
           // Relative to the previous sweep, in the truth's lidar frame.
-          const int j = jj;
           const std::vector<SE3>& e = odometry.poses();
           const SE3 d =
               j == 0 ? SE3()
@@ -382,7 +376,7 @@ int main(int argc, char** argv) {
           "%s %s seed %s index %s sweeps %d-%d%s: tracked %d of %d sweeps (error < 1 m); over "
           "them: path %.1f m, error at the end %.3f m (%.2f %%); over %d windows of %d sweeps "
           "(mean %.2f m): %.3f m (%.2f %%), %.3f deg; mean sigma %.2f m; %.0f ms CPU per sweep\n",
-          argv[2], argv[3], argv[4], argv[5], first, first + n - 1,
+          argv[2], argv[3], argv[4], argv[5], first, first + (n - 1) * stride,
           options.deskew ? "" : " (no deskew)", tracked, n, path, final_error,
           100.0 * final_error / std::max(path, 1e-9), windows, window, rel_d / std::max(windows, 1),
           rel_t / std::max(windows, 1), 100.0 * rel_t / std::max(rel_d, 1e-9),
