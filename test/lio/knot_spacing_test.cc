@@ -3,7 +3,7 @@
 // rotation against a walk, and the pipeline with a knot count that changes from sweep to sweep:
 // every sweep gets the count the rule gives for its own IMU samples, exactly that many knots are
 // marginalised after it, every IMU sample is measured once, and a run the rule never triggers in
-// is the fixed-count run bit for bit.
+// is the fixed-count run bit for bit; a split sweep's own keypoint budget.
 #include "ctlio/solvers/lio/knot_spacing.h"
 
 #include <gtest/gtest.h>
@@ -309,6 +309,58 @@ TEST(KnotSpacing, SplitSweepsUseTheVarianceFloors) {
   ASSERT_GT(accel_a, 0.0);
   EXPECT_LT(gyro_b, 0.5 * gyro_a);
   EXPECT_LT(accel_b, 0.1 * accel_a);
+}
+
+// window.adaptive_knots_max_keypoints: a split sweep registers up to that many keypoints instead
+// of lidar_frontend.max_keypoints (each processed fast sweep above the front end's cap here), and
+// a sweep the rule leaves whole keeps the front end's keypoints, so a walk's run is the run
+// without the key bit for bit.
+TEST(KnotSpacing, SplitSweepsGetTheirOwnKeypointBudget) {
+  OdometryConfig base = testing::SimLioConfig();
+  base.frontend.max_keypoints = 40;
+  base.adaptive_knots = Options(2, 0.15);
+  OdometryConfig budget = base;
+  budget.adaptive_knots.max_keypoints = 120;
+  const PipelineRun fast = RunPipeline(budget, sim::Regime::kFast);
+  const PipelineRun fast_capped = RunPipeline(base, sim::Regime::kFast);
+  ASSERT_EQ(fast.scans.size(), fast_capped.scans.size());
+  int above = 0;
+  for (size_t i = 2; i < fast.scans.size(); ++i) {  // from the second processed sweep on
+    ASSERT_GE(fast.expected[i], 2) << "scan " << i;
+    ASSERT_NE(fast.scans[i].status, ScanStatus::kFailed) << "scan " << i;
+    EXPECT_LE(fast_capped.scans[i].keypoints, 40) << "scan " << i;
+    EXPECT_LE(fast.scans[i].keypoints, 120) << "scan " << i;
+    EXPECT_GE(fast.scans[i].keypoints, fast_capped.scans[i].keypoints) << "scan " << i;
+    if (fast.scans[i].keypoints > 40) ++above;
+  }
+  EXPECT_GE(above, static_cast<int>(fast.scans.size()) - 3);
+  const PipelineRun walk = RunPipeline(budget, sim::Regime::kWalking);
+  const PipelineRun walk_capped = RunPipeline(base, sim::Regime::kWalking);
+  ASSERT_EQ(walk.scans.size(), walk_capped.scans.size());
+  for (size_t i = 1; i < walk.scans.size(); ++i) {
+    ASSERT_EQ(walk.expected[i], 1) << "scan " << i;
+    EXPECT_EQ(walk.scans[i].keypoints, walk_capped.scans[i].keypoints) << "scan " << i;
+    EXPECT_EQ(walk.scans[i].T_mr.Matrix(), walk_capped.scans[i].T_mr.Matrix()) << "scan " << i;
+  }
+}
+
+// The key is read and range-checked: a negative budget is an error naming the file and the key.
+TEST(KnotSpacing, SplitSweepKeypointBudgetIsReadAndChecked) {
+  const std::string path = ::testing::TempDir() + "/adaptive_knots_keypoints.yaml";
+  std::ofstream(path) << "window:\n  adaptive_knots_max_keypoints: 800\n";
+  EXPECT_EQ(LoadOdometryConfig(path).adaptive_knots.max_keypoints, 800);
+  std::ofstream(path) << "window:\n  adaptive_knots_max_keypoints: -5\n";
+  try {
+    LoadOdometryConfig(path);
+    ADD_FAILURE() << "a negative keypoint budget was accepted";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("adaptive_knots_max_keypoints"), std::string::npos) << what;
+    EXPECT_NE(what.find("adaptive_knots_keypoints.yaml"), std::string::npos) << what;
+  }
+  OdometryConfig c;
+  c.adaptive_knots.max_keypoints = -1;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 }  // namespace

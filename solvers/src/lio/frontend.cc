@@ -405,17 +405,21 @@ void LidarFrontend::SelectSweep(const std::vector<Vec3>& sweep_lidar, const SE3&
   }
 }
 
-std::vector<TimedPoint> LidarFrontend::Keypoints(
-    const std::vector<TimedPoint>& preprocessed) const {
-  std::vector<TimedPoint> keypoints =
-      VoxelGridSubsample(preprocessed, options_.keypoint_voxel_size);
-  const size_t cap = static_cast<size_t>(options_.max_keypoints);
+std::vector<TimedPoint> KeypointsOf(const std::vector<TimedPoint>& preprocessed,
+                                    double keypoint_voxel_size, int max_keypoints) {
+  std::vector<TimedPoint> keypoints = VoxelGridSubsample(preprocessed, keypoint_voxel_size);
+  const size_t cap = static_cast<size_t>(std::max(max_keypoints, 0));
   if (cap == 0 || keypoints.size() <= cap) return keypoints;
   // Evenly spaced subset: index i·n/cap, i = 0..cap−1 (deterministic, keeps the firing order).
   std::vector<TimedPoint> kept;
   kept.reserve(cap);
   for (size_t i = 0; i < cap; ++i) kept.push_back(keypoints[i * keypoints.size() / cap]);
   return kept;
+}
+
+std::vector<TimedPoint> LidarFrontend::Keypoints(
+    const std::vector<TimedPoint>& preprocessed) const {
+  return KeypointsOf(preprocessed, options_.keypoint_voxel_size, options_.max_keypoints);
 }
 
 void LidarFrontend::UpdateMap(const std::vector<Vec3>& points_map, const Vec3& robot_position_map) {

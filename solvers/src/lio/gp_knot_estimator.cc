@@ -252,6 +252,13 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
   const double t_prev = knots_.back().t;
   const int K = KnotsForScan(t_prev, scan.t_end);
   split_sweep_ = K > config_.knots_per_scan;
+  // A split sweep's own keypoint budget (knot_spacing.h): chosen from the same preprocessed
+  // points with the front end's rule, so only the cap differs.
+  const int split_cap = config_.adaptive_knots.max_keypoints;
+  use_split_keypoints_ = split_sweep_ && split_cap > 0;
+  if (use_split_keypoints_) {
+    split_keypoints_ = KeypointsOf(scan.points, config_.frontend.keypoint_voxel_size, split_cap);
+  }
   for (int i = 1; i <= K; ++i) {
     const double t = i == K ? scan.t_end : t_prev + (scan.t_end - t_prev) * i / K;
     AddKnotAndFactors(t, window, result);
@@ -355,10 +362,12 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
   for (size_t i = ScanStartIndex(); i < knots_.size(); ++i) {
     knots.push_back({knots_[i].t, knots_[i].keys});
   }
+  const std::vector<TimedPoint>& keypoints =
+      use_split_keypoints_ ? split_keypoints_ : scan.keypoints;
   auto term = estimates_extrinsic()
-                  ? std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints,
+                  ? std::make_unique<ContinuousLidarTerm>(model_, knots, keypoints,
                                                           scan.T_robot_lidar, window)
-                  : std::make_unique<ContinuousLidarTerm>(model_, knots, scan.keypoints, window);
+                  : std::make_unique<ContinuousLidarTerm>(model_, knots, keypoints, window);
   term->set_residual_blocks(config_.frontend.residual_blocks);
   return term;
 }

@@ -173,6 +173,9 @@ void OdometryConfig::Validate() const {
               adaptive_knots.gyro_variance_floor >= 0 &&
               std::isfinite(adaptive_knots.gyro_variance_floor),
           "window.adaptive_knots_accel_variance and _gyro_variance must be finite and >= 0");
+  require(adaptive_knots.max_keypoints >= 0 && adaptive_knots.max_keypoints <= 1000000,
+          "window.adaptive_knots_max_keypoints must be in [0, 1000000] (0: "
+          "lidar_frontend.max_keypoints)");
   require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
   for (const ImuSensor& s : imus) {
     require(s.accel_variance >= 0 && s.gyro_variance >= 0, "imus[].variances must be >= 0");
@@ -275,6 +278,9 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"adaptive_knots_accel_curvature", SetFromYaml(&c->adaptive_knots.accel_curvature)},
            {"adaptive_knots_accel_variance", SetFromYaml(&c->adaptive_knots.accel_variance_floor)},
            {"adaptive_knots_gyro_variance", SetFromYaml(&c->adaptive_knots.gyro_variance_floor)},
+           {"adaptive_knots_max_keypoints",
+            SetInRange(&c->adaptive_knots.max_keypoints, 0, 1000000, source,
+                       section + ".adaptive_knots_max_keypoints")},
            {"threads",
             SetInRange(&c->solver_threads, 1, kMaxConfigThreads, source, section + ".threads")},
            {"overlap", SetFromYaml(&c->overlap_stages)},

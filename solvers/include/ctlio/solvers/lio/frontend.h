@@ -30,6 +30,12 @@ std::vector<TimedPoint> RangeGate(const std::vector<TimedPoint>& points, double 
 std::vector<TimedPoint> VoxelGridSubsample(const std::vector<TimedPoint>& points,
                                            double voxel_size);
 
+// One keypoint per cubic voxel of keypoint_voxel_size (VoxelGridSubsample), and beyond
+// max_keypoints (0 = no cap) an evenly spaced subset in the input order (index i·n/cap, so a
+// sweep in time order stays covered over its span).
+std::vector<TimedPoint> KeypointsOf(const std::vector<TimedPoint>& preprocessed,
+                                    double keypoint_voxel_size, int max_keypoints);
+
 // Indices of the points (any frame) with min_range ≤ |p| ≤ max_range that are the first of their
 // voxel: the range gate and VoxelGridSubsample in one pass over a raw sweep, without copying it.
 // With threads > 1 the sweep is split into that many chunks processed in parallel and merged in

@@ -132,6 +132,10 @@ class GpKnotEstimator final : public Estimator {
   int64_t next_knot_ = 0;
   int scan_knots_ = 0;        // knots the last AddState added (0 after Initialise)
   bool split_sweep_ = false;  // the last AddState's sweep got more knots than knots_per_scan
+  // A split sweep's keypoints under window.adaptive_knots_max_keypoints (the lidar term holds a
+  // reference to them until the next AddState); used when use_split_keypoints_.
+  std::vector<TimedPoint> split_keypoints_;
+  bool use_split_keypoints_ = false;
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)

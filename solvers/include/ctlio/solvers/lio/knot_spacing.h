@@ -33,6 +33,11 @@ struct AdaptiveKnotOptions {
   // (docs/experiments/knot-spacing.md).
   double accel_variance_floor = 0.0;
   double gyro_variance_floor = 0.0;
+  // On such a sweep, at most this many keypoints instead of lidar_frontend.max_keypoints (0: the
+  // same cap), chosen from the sweep's preprocessed points as the front end chooses them
+  // (KeypointsOf). The lidar, not the GP's interpolation, limits a split sweep's estimate: with
+  // two knots the fitted IMU residuals are at the device noise (docs/experiments/knot-spacing.md).
+  int max_keypoints = 0;
 
   bool enabled(int knots_per_scan) const {
     return max_knots_per_scan > knots_per_scan && (gyro_curvature > 0.0 || accel_curvature > 0.0);
