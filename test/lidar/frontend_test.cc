@@ -368,6 +368,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.max_iterations, 10);
   EXPECT_EQ(o.solver_iterations, d.solver_iterations);
   EXPECT_EQ(o.point_noise_sigma, 0.03);
+  EXPECT_EQ(o.point_noise_angle, 0.0);
+  EXPECT_EQ(o.point_noise_angle, d.point_noise_angle);
   EXPECT_EQ(o.residual_blocks, "square_root");
   EXPECT_EQ(o.residual_blocks, d.residual_blocks);
   EXPECT_EQ(o.loss, d.loss);

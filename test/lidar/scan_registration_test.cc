@@ -317,5 +317,76 @@ TEST(ScanRegistration, KeptUpdatedRemovedAndAddedBlocks) {
   }
 }
 
+// point_noise_angle: σ_i = √(σ² + (θ·|q_i|)²), the configured σ without it.
+TEST(ScanRegistration, PointNoiseSigmaGrowsWithRange) {
+  LidarFrontendOptions o;
+  o.point_noise_sigma = 0.05;
+  EXPECT_EQ(PointNoiseSigma(o, Vec3(30.0, 0.0, 0.0)), 0.05);
+  o.point_noise_angle = 0.004;
+  EXPECT_NEAR(PointNoiseSigma(o, Vec3(0.0, 6.0, 8.0)), std::sqrt(0.05 * 0.05 + 0.04 * 0.04), 1e-15);
+  EXPECT_NEAR(PointNoiseSigma(o, Vec3(0.0, 0.0, 0.0)), 0.05, 1e-15);
+  EXPECT_NEAR(PointNoiseSigma(o, Vec3(-30.0, 0.0, 0.0)), std::sqrt(0.05 * 0.05 + 0.12 * 0.12),
+              1e-15);
+}
+
+// A term that records the (whitened) association of every residual it is given.
+class RecordingTerm final : public LidarTerm {
+ public:
+  explicit RecordingTerm(LidarTerm* inner) : inner_(inner) {}
+  size_t num_keypoints() const override { return inner_->num_keypoints(); }
+  void BeginRound() override { inner_->BeginRound(); }
+  void Locate(size_t i, Vec3* q, Vec3* p_map) override { inner_->Locate(i, q, p_map); }
+  ceres::ResidualBlockId AddResidual(size_t i, const PlaneAssociation& a, ceres::LossFunction* loss,
+                                     SlidingWindow* window) override {
+    last[i] = a;
+    return inner_->AddResidual(i, a, loss, window);
+  }
+  void UpdateResidual(size_t i, const PlaneAssociation& a) override {
+    last[i] = a;
+    inner_->UpdateResidual(i, a);
+  }
+  SE3 NewestPose() const override { return inner_->NewestPose(); }
+  std::map<size_t, PlaneAssociation> last;
+
+ private:
+  LidarTerm* inner_;
+};
+
+// In the registration each residual is whitened by its keypoint's own σ: the residual of a
+// keypoint 10 m away weighs less than one 4 m away, by the ratio of their σ, while without the
+// angle every keypoint has the configured σ; the room is registered either way.
+TEST(ScanRegistration, FarKeypointsAreWhitenedByTheirRangeDependentSigma) {
+  const Scene s = MakeScene(44, 300);
+  for (const double angle : {0.0, 0.005}) {
+    LidarFrontendOptions o = Options(0.0);
+    o.point_noise_sigma = 0.03;
+    o.point_noise_angle = angle;
+    SlidingWindow window(sweep::SweepWindowOptions(o));
+    window.AddPoseState(0, s.T_rm_initial);
+    sweep::RigidLidarTerm rigid(0, s.keypoints, window);
+    RecordingTerm term(&rigid);
+    const RegistrationSummary summary =
+        ScanRegistration(o, OdometryConfig().min_associations).Register(s.map, &term, &window);
+    ASSERT_FALSE(summary.degenerate);
+    EXPECT_GT(summary.associations, 250);
+    int near = 0, far = 0;
+    for (size_t i = 0; i < s.keypoints.size(); ++i) {
+      if (!summary.associated[i]) continue;
+      const PlaneAssociation& whitened = term.last.at(i);
+      const PlaneAssociation& plane = summary.planes[i];
+      const double range = plane.point_robot.norm();
+      const double sigma = std::sqrt(0.03 * 0.03 + angle * range * angle * range);
+      EXPECT_NEAR(whitened.weight * sigma, plane.weight, 1e-12 * plane.weight) << i;
+      near += range < 5.0;
+      far += range > 8.0;
+    }
+    EXPECT_GT(near, 10);
+    EXPECT_GT(far, 10);
+    EXPECT_LT(PoseDistance(window.Pose(0), s.T_rm_true),
+              0.25 * PoseDistance(s.T_rm_initial, s.T_rm_true))
+        << angle;
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio

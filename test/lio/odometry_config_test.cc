@@ -159,6 +159,12 @@ TEST(OdometryConfig, CountKeysOutOfRangeNameFileLineKeyAndRange) {
        "10000]"},
       {"neigh.yaml", "lidar_frontend:\n  max_neighbours: 99999\n",
        ":2: lidar_frontend.max_neighbours = 99999 is out of range"},
+      {"angle.yaml", "lidar_frontend:\n  point_noise_angle: 0.5\n",
+       ":2: lidar_frontend.point_noise_angle = 0.5 is out of range: must be in [0"},
+      {"angle_neg.yaml", "lidar_frontend:\n  point_noise_angle: -0.001\n",
+       ":2: lidar_frontend.point_noise_angle = -0.001 is out of range"},
+      {"angle_nan.yaml", "lidar_frontend:\n  point_noise_angle: .nan\n",
+       ":2: lidar_frontend.point_noise_angle = .nan is out of range"},
       {"per_method.yaml", "per_method:\n  imu_input:\n    window:\n      threads: 512\n",
        ":4: per_method.imu_input.window.threads = 512 is out of range"},
   };

@@ -56,6 +56,8 @@ void LidarFrontendOptions::Validate() const {
               residual_blocks == "square_root",
           "residual_blocks must be point, interval or square_root");
   require(point_noise_sigma > 0.0, "point_noise_sigma must be positive");
+  require(point_noise_angle >= 0.0 && point_noise_angle <= 0.1,
+          "point_noise_angle must be in [0, 0.1] rad (0 = off)");
   require(loss_scale > 0.0, "loss_scale must be positive");
   require(convergence_translation >= 0.0 && convergence_rotation >= 0.0,
           "convergence thresholds must be >= 0");
@@ -95,6 +97,8 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"max_iterations_without_imu", SetFromYaml(&o.max_iterations_without_imu)},
       {"solver_iterations_without_imu", SetFromYaml(&o.solver_iterations_without_imu)},
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},
+      {"point_noise_angle",
+       SetInRange(&o.point_noise_angle, 0.0, 0.1, source, "lidar_frontend.point_noise_angle")},
       {"loss", SetFromYaml(&o.loss)},
       {"loss_scale", SetFromYaml(&o.loss_scale)},
       {"residual_blocks", SetFromYaml(&o.residual_blocks)},

@@ -1,6 +1,7 @@
 #include "ctlio/solvers/lio/scan_registration.h"
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -15,6 +16,12 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 }  // namespace
+
+double PointNoiseSigma(const LidarFrontendOptions& o, const Vec3& q_robot) {
+  if (!(o.point_noise_angle > 0.0)) return o.point_noise_sigma;
+  const double angular = o.point_noise_angle * q_robot.norm();
+  return std::sqrt(o.point_noise_sigma * o.point_noise_sigma + angular * angular);
+}
 
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& o) {
   const double scale = o.loss_scale / o.point_noise_sigma;
@@ -98,7 +105,7 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
     // This round's residuals replace the previous round's, on the whitened planes.
     const auto whiten = [&](size_t i) {
       PlaneAssociation a = planes[i];
-      a.weight /= options_.point_noise_sigma;
+      a.weight /= PointNoiseSigma(options_, a.point_robot);
       return a;
     };
     int associations = 0;

@@ -71,7 +71,16 @@ struct LidarFrontendOptions {
   // plane-fit noise): residuals enter the problem as w/σ · nᵀ(p_ref − T_mr q), which sets their
   // weight against the GP prior (whitened by Q⁻¹, SPEC §2).
   double point_noise_sigma = 0.03;  // m
-  std::string loss = "cauchy";      // "cauchy", "huber" or "none"
+  // An angular part of a keypoint's σ (0 = off: point_noise_sigma for every keypoint):
+  //   σ_i² = point_noise_sigma² + (point_noise_angle · |q_i|)²,
+  // |q_i| the keypoint's distance from the robot frame's origin (the lidar is within centimetres of
+  // it). Errors that grow with range — a rotation error of the deskewing or of the map's plane fit,
+  // a plane fitted to the sparse map far away, a beam's angle — are absent from a constant σ, which
+  // then weighs the far keypoints of an open scene (a park's trees at 10–40 m) as much as a room's
+  // walls at 2–5 m: one σ had to serve both (docs/experiments/scoreboard.md, cause W). The robust
+  // loss acts on the whitened residual (its scale stays loss_scale / point_noise_sigma).
+  double point_noise_angle = 0.0;  // rad
+  std::string loss = "cauchy";     // "cauchy", "huber" or "none"
   double loss_scale = 0.1;  // metres, on the planarity-weighted residual w·nᵀ(p_ref − T_mr q)
   // Residual blocks of the continuous-time point-to-plane residuals (Singer-LIO, lidar_gyro,
   // lidar_only; with the extrinsic estimated and in the IMU-as-input baseline always "point"):

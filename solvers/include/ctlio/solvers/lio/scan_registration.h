@@ -95,6 +95,10 @@ struct RegistrationSummary {
 // "none".
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& options);
 
+// The σ that whitens the residual of a keypoint at q_robot (robot frame):
+// √(point_noise_sigma² + (point_noise_angle·|q_robot|)²); point_noise_sigma when the angle is 0.
+double PointNoiseSigma(const LidarFrontendOptions& options, const Vec3& q_robot);
+
 class ScanRegistration {
  public:
   ScanRegistration(const LidarFrontendOptions& options, int min_associations);
