@@ -147,5 +147,39 @@ TEST(CovarianceMapError, AddsTheMapCovariance) {
   }
 }
 
+// window.pose_covariance_map_growth (map_growth_covariance.h): the estimate bit for bit, the
+// covariance the window's plus the map's error as built, Σ_map, which starts at zero (the first
+// scans register against the exact first map) and only grows (each scan adds g·β²·Σ_rel ≥ 0).
+TEST(CovarianceMapGrowth, SameEstimateCovariancePlusAGrowingMapError) {
+  for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
+    const sim::SimConfig c = testing::ShortSparseSequence();
+    OdometryConfig config = testing::SimLioConfig();
+    config.method = m;
+    config.pose_covariance = true;
+    config.pose_covariance_adaptive = false;
+    sim::SimulatedSource a_source(c), b_source(c);
+    const lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
+    config.pose_covariance_map_growth = 1.0;
+    const lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+    ASSERT_EQ(a.scans.size(), b.scans.size());
+    Mat6 previous = Mat6::Zero();
+    int compared = 0, grew = 0;
+    for (size_t k = 0; k < a.scans.size(); ++k) {
+      EXPECT_EQ(a.scans[k].T_mr.Matrix(), b.scans[k].T_mr.Matrix()) << LioMethodName(m) << k;
+      ASSERT_EQ(a.scans[k].has_pose_covariance, b.scans[k].has_pose_covariance);
+      if (!a.scans[k].has_pose_covariance) continue;
+      const Mat6 map = b.scans[k].pose_covariance - a.scans[k].pose_covariance;
+      const double tol = 1e-8 * b.scans[k].pose_covariance.norm();
+      if (compared == 0) EXPECT_LT(map.norm(), tol) << LioMethodName(m);
+      EXPECT_GE(MinEigenvalue(map - previous), -tol) << LioMethodName(m) << " scan " << k;
+      if ((map - previous).trace() > 1e-3 * b.scans[k].pose_covariance.trace()) ++grew;
+      previous = map;
+      ++compared;
+    }
+    EXPECT_GE(compared, 5) << LioMethodName(m);
+    EXPECT_GE(grew, 1) << LioMethodName(m);  // by more than 0.1 % of the covariance at least once
+  }
+}
+
 }  // namespace
 }  // namespace ctlio::lio

@@ -118,8 +118,21 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_m, 0.002);
   EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_rad, 0.0002);
   EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_scale, 0.16);
+  // The map's error as built: Singer-LIO's on the VLP-16 (data/sensors/vlp16.yaml), the
+  // baseline's on the Newer College-like preset (data/newer_college_lio.yaml).
+  EXPECT_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 0.0);
+  const OdometryConfig v =
+      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml");
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.0025);
+  EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
+  const OdometryConfig nc =
+      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
+  EXPECT_DOUBLE_EQ(nc.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 1.0);
+  EXPECT_EQ(nc.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 0.0);
   for (const char* key : {"pose_covariance_lidar_floor_m", "pose_covariance_lidar_floor_rad",
-                          "pose_covariance_map_sigma_m", "pose_covariance_map_sigma_rad"}) {
+                          "pose_covariance_map_sigma_m", "pose_covariance_map_sigma_rad",
+                          "pose_covariance_map_growth"}) {
     for (const char* bad : {"-0.001", "1e9", ".nan"}) {
       const std::string path =
           WriteTemp("floor_bad.yaml", std::string("window:\n  ") + key + ": " + bad + "\n");

@@ -239,6 +239,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   result->gyro_dof = gyro.dof;
 
   const auto t_map = std::chrono::steady_clock::now();
+  const size_t kept = std::exchange(map_points_kept_, 0), map_size = map_size_;
   const bool plausible = EstimatePlausible(result);
   const bool restored = !plausible && without_imu_.Restore(registered, &window_);
   if (plausible) {
@@ -251,13 +252,17 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
       // Joined before anything reads the map (StartOverlappedStages' task, or RunScan).
       StartMapInsertion();
     } else {
-      frontend_.UpdateMap(map_points_, map_position_);
+      InsertMapPoints();
     }
   }
   if (registered.degenerate) ReportDegenerate(result);
   if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
   result->ms_map += MsSince(t_map);
   estimator_->Report(result);
+  // The previous scan's insertion, joined by now in either mode (map_growth_covariance.h).
+  if (config_.pose_covariance) {
+    covariance_models_.growth.Inserted(kept, map_size, config_.pose_covariance_map_growth);
+  }
   if (config_.pose_covariance && !restored) {
     const std::optional<Mat6> S = NewestPoseCovariance(config_, registered, lidar.get(),
                                                        *estimator_, last_marginalization_.prior,
@@ -288,10 +293,17 @@ SE3 LioOdometry::CurrentExtrinsic() const {
   return window_.HasState(kExtrinsicKey) ? window_.Pose(kExtrinsicKey) : config_.T_imu_lidar;
 }
 
+void LioOdometry::InsertMapPoints() {
+  const size_t before = frontend_.map().num_points();
+  frontend_.UpdateMap(map_points_, map_position_);  // RemoveFar may also drop far voxels
+  map_size_ = frontend_.map().num_points();
+  map_points_kept_ = map_size_ > before ? map_size_ - before : 0;
+}
+
 void LioOdometry::StartMapInsertion() {
   map_insertion_ = std::async(std::launch::async, [this] {
     const auto t0 = std::chrono::steady_clock::now();
-    frontend_.UpdateMap(map_points_, map_position_);
+    InsertMapPoints();
     return MsSince(t0);
   });
 }

@@ -159,6 +159,8 @@ void OdometryConfig::Validate() const {
               pose_covariance_map_sigma_rad >= 0 && pose_covariance_map_sigma_rad <= 10,
           "window.pose_covariance_map_sigma_m must be in [0, 1e3] and "
           "window.pose_covariance_map_sigma_rad in [0, 10]");
+  require(pose_covariance_map_growth >= 0 && pose_covariance_map_growth <= 100,
+          "window.pose_covariance_map_growth must be in [0, 100]");
   require(window_knots >= 2 && window_knots <= kMaxWindowKnots,
           "window.knots must be in [2, 1000]");
   require(knots_per_scan >= 1 && knots_per_scan <= 10, "window.knots_per_scan must be in [1, 10]");
@@ -294,7 +296,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"pose_covariance_lidar_floor_m", SetFromYaml(&c->pose_covariance_lidar_floor_m)},
            {"pose_covariance_lidar_floor_rad", SetFromYaml(&c->pose_covariance_lidar_floor_rad)},
            {"pose_covariance_map_sigma_m", SetFromYaml(&c->pose_covariance_map_sigma_m)},
-           {"pose_covariance_map_sigma_rad", SetFromYaml(&c->pose_covariance_map_sigma_rad)}});
+           {"pose_covariance_map_sigma_rad", SetFromYaml(&c->pose_covariance_map_sigma_rad)},
+           {"pose_covariance_map_growth", SetFromYaml(&c->pose_covariance_map_growth)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

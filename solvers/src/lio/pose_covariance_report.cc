@@ -5,6 +5,17 @@
 #include "ctlio/solvers/lio/pose_covariance.h"
 
 namespace ctlio::lio {
+namespace {
+
+// Σ = Σ_rel + Σ_map: the configured map error and the one the map was built with (the latter
+// before this scan's insertion is accounted, map_growth_covariance.h (1)).
+Mat6 WithMapError(const OdometryConfig& config, const Mat6& relative,
+                  PoseCovarianceModels* models) {
+  if (config.pose_covariance_map_growth > 0.0) models->growth.Registered(relative);
+  return relative + MapCovariance(config) + models->growth.map();
+}
+
+}  // namespace
 
 std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
                                          const RegistrationSummary& registered, LidarTerm* term,
@@ -40,7 +51,7 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
         models->adaptive.Compute(window, pose, lidar_estimate, lidar, imu.accel, imu.gyro,
                                  marginal_prior, T_mr, tangent_from_body);
     if (!S) return std::nullopt;
-    return *S + MapCovariance(config);
+    return WithMapError(config, *S, models);
   }
   const double scale = config.pose_covariance_lidar_scale;
   const double floor_m = config.pose_covariance_lidar_floor_m;
@@ -55,7 +66,7 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
           ? PoseCovariance(&window->problem(), window->State(pose), T_mr, tangent_from_body)
           : ScaledPoseCovariance(*window, pose, lidar, scale, T_mr, tangent_from_body);
   if (!S) return std::nullopt;
-  return *S + MapCovariance(config);
+  return WithMapError(config, *S, models);
 }
 
 Mat6 MapCovariance(const OdometryConfig& config) {

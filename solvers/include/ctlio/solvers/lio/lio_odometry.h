@@ -165,12 +165,19 @@ class LioOdometry {
   std::vector<Vec3> map_points_;
   Vec3 map_position_ = Vec3::Zero();
   bool map_points_inserted_ = false;  // by the newest scan (newest_map_points)
+  // The last insertion of a processed scan: points the map kept, and its size after
+  // (InsertMapPoints; the map's error as built, window.pose_covariance_map_growth).
+  size_t map_points_kept_ = 0;
+  size_t map_size_ = 0;
   // config.overlap_stages: whether this scan's marginalisation is done (overlapped with its
   // preprocessing).
   bool slid_ = false;
   // The running map insertion (StartMapInsertion). Last: destroyed first, which waits for it
   // while the map and the points it reads still exist.
   std::future<double> map_insertion_;
+
+  // frontend_.UpdateMap of the newest scan's map points, counting what the map kept.
+  void InsertMapPoints();
 };
 
 // The pipeline of config.method.

@@ -209,6 +209,12 @@ struct OdometryConfig {
   // (sparse sensors; docs/experiments/covariance.md). 0 and 0: none. The estimate is unchanged.
   double pose_covariance_map_sigma_m = 0.0;
   double pose_covariance_map_sigma_rad = 0.0;
+  // window.pose_covariance_map_growth g: the map's error as it was built, added to the reported
+  // covariance — each scan moves the map by the fraction of the map's points it inserts times its
+  // own relative error, Σ_map += g·β²·Σ_rel (map_growth_covariance.h; 1 = the model as derived).
+  // For sparse sensors whose start-up error stays in the map (docs/experiments/covariance.md,
+  // "16 beams"). 0: none. The estimate is unchanged.
+  double pose_covariance_map_growth = 0.0;
 
   // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
   // every one). Bounded so that the pipeline's memory does not grow with the length of the run

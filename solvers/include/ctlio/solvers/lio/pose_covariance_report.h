@@ -9,8 +9,10 @@
 // point noise plus a rigid per-scan error carried from scan to scan (lidar_floor_covariance.h);
 // else the window as solved (pose_covariance_lidar_scale 1), or with the lidar blocks' variance
 // multiplied by that scale. Each adds the map's own error
-// (window.pose_covariance_map_sigma_m/_rad). Not the lidar term's plain χ² (LidarChiSquareScale):
-// its spread alone made the baseline 40× overconfident (docs/experiments/covariance.md).
+// (window.pose_covariance_map_sigma_m/_rad, and the map's error as it was built,
+// window.pose_covariance_map_growth: map_growth_covariance.h). Not the lidar term's plain χ²
+// (LidarChiSquareScale): its spread alone made the baseline 40× overconfident
+// (docs/experiments/covariance.md).
 #pragma once
 
 #include <optional>
@@ -18,6 +20,7 @@
 #include "ctlio/solvers/lio/adaptive_covariance.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/lidar_floor_covariance.h"
+#include "ctlio/solvers/lio/map_growth_covariance.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "ctlio/solvers/lio/scan_registration.h"
 #include "ctlio/solvers/sliding_window.h"
@@ -28,6 +31,7 @@ namespace ctlio::lio {
 struct PoseCovarianceModels {
   AdaptiveNoiseScales adaptive;   // window.pose_covariance_adaptive
   FlooredPoseCovariance floored;  // window.pose_covariance_lidar_floor_*
+  MapGrowthCovariance growth;     // window.pose_covariance_map_growth
 };
 
 // Σ_map of OdometryConfig::pose_covariance_map_sigma_m/_rad: a rigid map error Exp(m) adds Cov(m)
