@@ -99,6 +99,8 @@ TEST(OdometryConfigComposition, CalibrationOverlayWorksOnEveryShippedConfig) {
     EXPECT_EQ(cal.knots_per_scan, 2);
     EXPECT_TRUE(cal.imu_prediction);
     EXPECT_EQ(cal.frontend.max_keypoints, 2400);
+    EXPECT_EQ(cal.input_interpolation, "cubic");  // the baseline's, calibration.md
+    EXPECT_EQ(cal.input_substeps, 4);
     EXPECT_DOUBLE_EQ(cal.calibration.write_max_sigma_s, 5e-4);
     EXPECT_DOUBLE_EQ(cal.calibration.write_max_sigma_deg, 0.1);
     EXPECT_DOUBLE_EQ(cal.calibration.write_max_sigma_m, 0.01);

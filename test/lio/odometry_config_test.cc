@@ -36,6 +36,47 @@ TEST(OdometryConfig, DefaultBaselineIntegrationIsTheMidpointOne) {
       LoadOdometryConfig(WriteTemp("zoh.yaml", "imu:\n  input_midpoint: false\n")).input_midpoint);
 }
 
+// The baseline's reading of the signal between samples (imu.input_interpolation, input_substeps;
+// docs/experiments/calibration.md): defaults unchanged, read, and range-checked with the file.
+TEST(OdometryConfig, BaselineInterpolationAndSubstepsAreReadAndChecked) {
+  EXPECT_EQ(OdometryConfig().input_interpolation, "linear");
+  EXPECT_EQ(OdometryConfig().input_substeps, 1);
+  const OdometryConfig c = LoadOdometryConfig(
+      WriteTemp("cubic.yaml", "imu:\n  input_interpolation: cubic\n  input_substeps: 4\n"));
+  EXPECT_EQ(c.input_interpolation, "cubic");
+  EXPECT_EQ(c.input_substeps, 4);
+  for (const char* n : {"0", "17", "-2"}) {
+    const std::string path =
+        WriteTemp("substeps.yaml", std::string("imu:\n  input_substeps: ") + n + "\n");
+    try {
+      LoadOdometryConfig(path);
+      ADD_FAILURE() << n << ": no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ":2: imu.input_substeps = " + n +
+                                           " is out of range: must be in [1, 16]"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  const auto error = [](const std::string& name, const std::string& text) {
+    try {
+      LoadOdometryConfig(WriteTemp(name, text));
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("quad.yaml", "imu:\n  input_interpolation: quadratic\n")
+                .find("imu.input_interpolation must be linear or cubic"),
+            std::string::npos);
+  EXPECT_NE(error("held.yaml", "imu:\n  input_midpoint: false\n  input_interpolation: cubic\n")
+                .find("need imu.input_midpoint: true"),
+            std::string::npos);
+  EXPECT_NE(error("held4.yaml", "imu:\n  input_midpoint: false\n  input_substeps: 4\n")
+                .find("need imu.input_midpoint: true"),
+            std::string::npos);
+}
+
 TEST(OdometryConfig, ShippedConfigsLoad) {
   const OdometryConfig sim =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");

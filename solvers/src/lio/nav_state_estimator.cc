@@ -231,7 +231,12 @@ std::vector<ImuSegment> NavStateEstimator::InputSegments(double t_a, double t_b,
                                                          double* max_gap) const {
   std::vector<ImuSegment> segments = imu_.Segments(t_a, t_b, max_gap, config_.input_imu);
   if (config_.input_midpoint) {
-    InterpolateAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
+    SplitSegments(config_.input_substeps, &segments);
+    if (config_.input_interpolation == "cubic") {
+      InterpolateCubicAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
+    } else {
+      InterpolateAtMidpoints(imu_, imu_.samples(config_.input_imu), &segments);
+    }
   }
   const Mat3 C_ri = config_.ImuPose(config_.input_imu).rotation();
   if (!C_ri.isIdentity(0.0)) {

@@ -142,6 +142,13 @@ void OdometryConfig::Validate() const {
   require(gravity > 0, "imu.gravity must be positive");
   require(input_accel_sigma > 0 && input_gyro_sigma > 0 && imu_rate_hint > 0,
           "imu input noise densities and rate must be positive");
+  require(input_interpolation == "linear" || input_interpolation == "cubic",
+          "imu.input_interpolation must be linear or cubic");
+  require(input_substeps >= 1 && input_substeps <= kMaxInputSubsteps,
+          "imu.input_substeps must be in [1, 16]");
+  require(input_midpoint || (input_interpolation == "linear" && input_substeps == 1),
+          "imu.input_interpolation cubic and imu.input_substeps > 1 need imu.input_midpoint: true "
+          "(a held sample has no value between samples to read)");
   require(gravity_init_duration >= 0 && gravity_init_max_std > 0, "bad init parameters");
   require(min_associations >= 0, "init.min_associations must be >= 0");
   require(max_imu_gap > 0, "init.max_imu_gap must be positive");
@@ -257,6 +264,9 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
                    {"input_accel_sigma", SetFromYaml(&c->input_accel_sigma)},
                    {"input_gyro_sigma", SetFromYaml(&c->input_gyro_sigma)},
                    {"input_midpoint", SetFromYaml(&c->input_midpoint)},
+                   {"input_interpolation", SetFromYaml(&c->input_interpolation)},
+                   {"input_substeps", SetInRange(&c->input_substeps, 1, kMaxInputSubsteps, source,
+                                                 section + ".input_substeps")},
                    {"rate_hint", SetFromYaml(&c->imu_rate_hint)},
                    {"gap_velocity_walk", SetFromYaml(&c->gap_velocity_walk)},
                    {"gap_hold_max", SetFromYaml(&c->gap_hold_max)},

@@ -29,6 +29,9 @@ class Node;
 
 namespace ctlio::lio {
 
+// Upper bound of imu.input_substeps (each substep is one preintegration step).
+inline constexpr int kMaxInputSubsteps = 16;
+
 enum class LioMethod {
   kSingerLio,  // GP (Singer) prior, lidar + gyro + accelerometer as measurements, biases
   kLidarGyro,  // same without the accelerometer
@@ -72,6 +75,16 @@ struct OdometryConfig {
   // not describe: docs/experiments/covariance.md), or, false, the paper's zero-order hold (each
   // sample held from its stamp to the next).
   bool input_midpoint = true;
+  // IMU-input baseline, with input_midpoint: how the signal between samples is read. "linear"
+  // (the default) takes the line through the two samples around a segment's midpoint; "cubic"
+  // the cubic through the four around it (two each side; the line where the stream has fewer),
+  // and each sample period is integrated in `input_substeps` equal parts, each at its own
+  // midpoint. The line's mean over a period is off by Δt²/12·f̈ and a constant rate per period
+  // drops the rotation's coupling within it (coning and sculling, O(Δt²)): in fast motion at
+  // 200 Hz they biased the lever arm by +1.6 / +1.4 cm (y / z), which cubic with 4 substeps
+  // removes (docs/experiments/calibration.md, "The baseline's fast lever-arm bias").
+  std::string input_interpolation = "linear";  // linear | cubic
+  int input_substeps = 1;                      // [1, kMaxInputSubsteps]
   // IMU-input baseline across an IMU gap (no preintegration there): the velocity is a random
   // walk with this variance per second [(m/s)²/s] between the states around the gap.
   double gap_velocity_walk = 4.0;
