@@ -17,6 +17,7 @@
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/pose_covariance_report.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
+#include "ctlio/solvers/lio/scan_status.h"
 #include "ctlio/solvers/lio/state_keys.h"
 #include "scan_clock.h"
 
@@ -240,7 +241,10 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
 
   const auto t_map = std::chrono::steady_clock::now();
   const size_t kept = std::exchange(map_points_kept_, 0), map_size = map_size_;
-  const bool plausible = EstimatePlausible(result);
+  const SE3 T_mr = estimator_->NewestPose();
+  const bool plausible =
+      CheckPlausibleJump((T_mr.translation() - estimator_->PreviousPose().translation()).norm(),
+                         T_mr.translation().allFinite(), config_.max_scan_translation, result);
   const bool restored = !plausible && without_imu_.Restore(registered, &window_);
   if (plausible) {
     estimator_->MapPoints(scan, &map_points_);
@@ -255,8 +259,8 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
       InsertMapPoints();
     }
   }
-  if (registered.degenerate) ReportDegenerate(result);
-  if (!uses_imu() && result->degeneracy.num_degenerate() > 0) ReportDegenerateDirections(result);
+  if (registered.degenerate) MarkTooFewAssociations(config_.min_associations, uses_imu(), result);
+  if (!uses_imu() && result->degeneracy.num_degenerate() > 0) MarkDegenerateDirections(result);
   result->ms_map += MsSince(t_map);
   estimator_->Report(result);
   // The previous scan's insertion, joined by now in either mode (map_growth_covariance.h).
@@ -340,28 +344,6 @@ void LioOdometry::ReportImuGap(double t_begin, double t_end, ScanResult* result)
   result->message = m.str();
 }
 
-bool LioOdometry::EstimatePlausible(ScanResult* result) const {
-  const SE3 T_mr = estimator_->NewestPose();
-  const double jump = (T_mr.translation() - estimator_->PreviousPose().translation()).norm();
-  if (T_mr.translation().allFinite() && jump <= config_.max_scan_translation) return true;
-  // Do not pollute the map with a diverged pose; report it.
-  std::ostringstream m;
-  m << "pose jumped " << jump << " m in one scan (limit " << config_.max_scan_translation
-    << " m): estimate diverged";
-  result->status = ScanStatus::kFailed;
-  result->message = m.str();
-  return false;
-}
-
-void LioOdometry::ReportDegenerate(ScanResult* result) const {
-  if (result->status != ScanStatus::kOk) return;
-  result->status = ScanStatus::kDegenerate;
-  result->message = "only " + std::to_string(result->associations) + " plane associations (need " +
-                    std::to_string(config_.min_associations) +
-                    "): lidar term dropped for this scan, the prior" +
-                    (uses_imu() ? " and the IMU carry" : " carries") + " the state";
-}
-
 void LioOdometry::AnalyseDegeneracy(const RegistrationSummary& registered, const SE3& predicted,
                                     ScanResult* result) {
   const DegeneracyOptions& o = config_.degeneracy;
@@ -386,18 +368,6 @@ void LioOdometry::AnalyseDegeneracy(const RegistrationSummary& registered, const
   result->solver_iterations += static_cast<int>(solved.iterations.size());
   result->final_cost = solved.final_cost;
   report.remapped = true;
-}
-
-void LioOdometry::ReportDegenerateDirections(ScanResult* result) const {
-  if (result->status != ScanStatus::kOk) return;
-  result->status = ScanStatus::kDegenerate;
-  result->message = std::to_string(result->degeneracy.num_degenerate()) +
-                    " degenerate direction(s) of the lidar term (least constrained " +
-                    result->degeneracy.DirectionString() + " in the body frame): no IMU to carry " +
-                    (result->degeneracy.remapped
-                         ? "them, the constant-velocity prediction is kept along them (solution "
-                           "remapping)"
-                         : "them (degeneracy.remap off: the estimate along them is the lidar's)");
 }
 
 std::unique_ptr<LioOdometry> MakeLioOdometry(const OdometryConfig& config) {

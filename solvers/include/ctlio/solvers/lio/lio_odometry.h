@@ -123,16 +123,11 @@ class LioOdometry {
   // in it: for the GP pipelines every IMU (one IMU with data is a measurement of the whole
   // state), for the baseline its input IMU.
   void ReportImuGap(double t_begin, double t_end, ScanResult* result) const;
-  // False (and the scan failed) if the newest pose jumped implausibly far.
-  bool EstimatePlausible(ScanResult* result) const;
-  void ReportDegenerate(ScanResult* result) const;
   // Degenerate directions of the registered lidar term (degeneracy.h): reported in the result;
   // lidar_only and a GP method in an IMU outage keep `predicted` (the newest pose state before
   // registration) along them.
   void AnalyseDegeneracy(const RegistrationSummary& registered, const SE3& predicted,
                          ScanResult* result);
-  // lidar_only with a degenerate direction: the scan is `degenerate` (remapped or not).
-  void ReportDegenerateDirections(ScanResult* result) const;
   // Input gate: an IMU whose output stayed bit-identical for config.input.constant_imu_duration
   // while the estimate moved since the previous estimated scan makes the scan kSuspect. Here,
   // not in ImuBuffer: only the odometry knows whether the lidar moved.
