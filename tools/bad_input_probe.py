@@ -20,6 +20,9 @@ The findings are the outcomes the bad-input promise rules out ("never crashes, n
   python3 tools/bad_input_probe.py --build build-test --out /tmp/probe [--seed 7] [--only imu]
   # a sample of 40 cases under ASan + UBSan (the programs of scripts/fuzz.sh's instrumented tree):
   python3 tools/bad_input_probe.py --odometry build-fuzz/apps/lio/ctlio_odometry --sample 40 ...
+  # the readers alone under the sanitizers: every scan of each mutated folder or bag decoded by
+  # ctlio_geometry_report (the readers and their checks, no estimator; outcomes error / read):
+  python3 tools/bad_input_probe.py --reader build-fuzz/apps/ctlio_geometry_report ...
 
 The bag mutations run on a ROS 1 bag (class `bag`) and on ROS 2 bag folders with MCAP
 (`ros2_mcap`) and SQLite (`ros2_sqlite3`) storage, the layouts ctlio_simulate writes.
@@ -369,6 +372,9 @@ def main():
     ap.add_argument("--odometry", default="",
                     help="the ctlio_odometry to probe (default: <build>/apps/lio/ctlio_odometry); "
                     "an instrumented one makes sanitizer reports findings")
+    ap.add_argument("--reader", default="",
+                    help="instead of the odometry, read every scan with this ctlio_geometry_report "
+                    "(the folder and bag classes only)")
     ap.add_argument("--sample", type=int, default=0,
                     help="run only this many cases, drawn from --seed (0: all)")
     ap.add_argument("--bag_layouts", default="rosbag,ros2,ros2_sqlite3",
@@ -415,6 +421,8 @@ def main():
             for cls, name, op in ros2_mutations(rng, clean_bags[layout], cls):
                 cases.append((cls, name, layout, op))
     cases = [c for c in cases if a.only in c[0]]
+    if a.reader:
+        cases = [c for c in cases if c[2] not in ("config", "flags")]
     if a.sample and a.sample < len(cases):
         cases = [cases[i] for i in sorted(rng.sample(range(len(cases)), a.sample))]
 
@@ -467,8 +475,14 @@ def main():
             args.append(f"--dataset={d}")
             names = ["m_ros2", os.path.basename(f), "metadata.yaml"]
         args.append(f"--out={out_dir}")
+        if a.reader:
+            args = [a.reader, args[-2], "--first=1000000", "--scans=1000000"]
         rc, log, peak, secs = run(args, a.timeout, os.path.join(work, "log.txt"))
         outcome, msg = judge(rc, log, peak, out_dir, names, clean_ate)
+        # Every scan decoded: ctlio_geometry_report then says it had fewer than the 10⁶ asked for.
+        if a.reader and (outcome in ("accurate", "run_failed") or (
+                outcome == "error" and "of the 1000000 sweeps asked for" in log)):
+            outcome = "read"
         rows.append(dict(cls=cls, name=name, outcome=outcome, rc=rc, seconds=f"{secs:.1f}",
                          peak_mb=f"{peak:.0f}", message=msg.replace("\n", " ")))
         flag = "  <-- FINDING" if outcome in FINDINGS else ""
