@@ -13,9 +13,19 @@ Each run is classified:
   nan_exit0        exit 0 with NaN or Inf in the trajectory or the ATE (a finding)
   silent_wrong     exit 0, ATE above 3x the clean run's, no warning in evaluation.txt (a finding)
   memory           peak resident memory above 1 GB (a finding)
+  sanitizer        an AddressSanitizer / UndefinedBehaviorSanitizer report (a finding; with
+                   --odometry pointing at an instrumented build)
 The findings are the outcomes the bad-input promise rules out ("never crashes, never lies").
 
   python3 tools/bad_input_probe.py --build build-test --out /tmp/probe [--seed 7] [--only imu]
+  # a sample of 40 cases under ASan + UBSan (the programs of scripts/fuzz.sh's instrumented tree):
+  python3 tools/bad_input_probe.py --odometry build-fuzz/apps/lio/ctlio_odometry --sample 40 ...
+  # the readers alone under the sanitizers: every scan of each mutated folder or bag decoded by
+  # ctlio_geometry_report (the readers and their checks, no estimator; outcomes error / read):
+  python3 tools/bad_input_probe.py --reader build-fuzz/apps/ctlio_geometry_report ...
+
+The bag mutations run on a ROS 1 bag (class `bag`) and on ROS 2 bag folders with MCAP
+(`ros2_mcap`) and SQLite (`ros2_sqlite3`) storage, the layouts ctlio_simulate writes.
 
 Writes <out>/probe.csv (one line per mutant) and prints the count per class and outcome.
 The mutants are drawn from --seed; a different seed gives mutants the tests never saw.
@@ -33,7 +43,9 @@ import subprocess
 import sys
 import time
 
-FINDINGS = {"error_unnamed", "crash", "hang", "nan_exit0", "silent_wrong", "memory"}
+FINDINGS = {"error_unnamed", "crash", "hang", "nan_exit0", "silent_wrong", "memory", "sanitizer"}
+SANITIZER_MARKS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:",
+                   "UndefinedBehaviorSanitizer")
 WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
                  "points_dropped_out_of_interval", "scans_skipped", "constant_imu_scans",
                  "lidar_gaps", "overlapping_scans")
@@ -236,16 +248,45 @@ FLAG_MUTATIONS = [
 ]
 
 
-def bag_mutations(rng, size):
+def bag_mutations(rng, size, cls="bag"):
     out = []
     for k in range(8):
         cut = rng.randrange(13, size)
-        out.append(("bag", f"truncated_at_{cut}", ("truncate", cut)))
+        out.append((cls, f"truncated_at_{cut}", ("truncate", cut)))
     for k in range(12):
         n = rng.choice((1, 4, 64))
-        out.append(("bag", f"byte_flips_{n}_{k}",
+        out.append((cls, f"byte_flips_{n}_{k}",
                     ("flip", [(rng.randrange(size), rng.randrange(256)) for _ in range(n)])))
     return out
+
+
+def ros2_storage_file(folder):
+    """The one storage file (.mcap or .db3) of a ROS 2 bag folder."""
+    files = [f for f in os.listdir(folder) if f.endswith((".mcap", ".db3"))]
+    assert len(files) == 1, (folder, files)
+    return os.path.join(folder, files[0])
+
+
+def ros2_mutations(rng, folder, cls):
+    """Byte edits of the storage file (as for the ROS 1 bag) and of the folder around it."""
+    out = bag_mutations(rng, os.path.getsize(ros2_storage_file(folder)), cls)
+    out.append((cls, "metadata_missing", ("metadata", None)))
+    out.append((cls, "metadata_garbage", ("metadata", "rosbag2_bagfile_information: [[[\n")))
+    out.append((cls, "metadata_wrong_storage",
+                ("metadata_sub", ("storage_identifier: mcap", "storage_identifier: sqlite3")
+                 if cls == "ros2_mcap" else
+                 ("storage_identifier: sqlite3", "storage_identifier: mcap"))))
+    out.append((cls, "storage_file_missing", ("remove", None)))
+    return out
+
+
+def mutate_bytes(data, what):
+    data = bytearray(data)
+    if what[0] == "truncate":
+        return bytes(data[:what[1]])
+    for pos, val in what[1]:
+        data[pos] = val
+    return bytes(data)
 
 
 # ---------------------------------------------------------------- running and judging
@@ -294,6 +335,10 @@ def judge(rc, log, peak_mb, out_dir, names, clean_ate):
         return "hang", ""
     last = [l for l in log.splitlines() if l.strip()]
     msg = last[-1][:200] if last else ""
+    for mark in SANITIZER_MARKS:
+        i = log.find(mark)
+        if i >= 0:
+            return "sanitizer", log[i:i + 200]
     if peak_mb > 1024:
         return "memory", msg
     if rc < 0:
@@ -324,12 +369,22 @@ def main():
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--only", default="", help="run only classes containing this text")
     ap.add_argument("--timeout", type=float, default=180)
+    ap.add_argument("--odometry", default="",
+                    help="the ctlio_odometry to probe (default: <build>/apps/lio/ctlio_odometry); "
+                    "an instrumented one makes sanitizer reports findings")
+    ap.add_argument("--reader", default="",
+                    help="instead of the odometry, read every scan with this ctlio_geometry_report "
+                    "(the folder and bag classes only)")
+    ap.add_argument("--sample", type=int, default=0,
+                    help="run only this many cases, drawn from --seed (0: all)")
+    ap.add_argument("--bag_layouts", default="rosbag,ros2,ros2_sqlite3",
+                    help="bag layouts to mutate (ctlio_simulate --layout values)")
     ap.add_argument("--config", default=os.path.join(os.path.dirname(__file__), "..", "data",
                                                       "sim_lio.yaml"))
     a = ap.parse_args()
     rng = random.Random(a.seed)
     sim = os.path.join(a.build, "apps", "ctlio_simulate")
-    odo = os.path.join(a.build, "apps", "lio", "ctlio_odometry")
+    odo = a.odometry or os.path.join(a.build, "apps", "lio", "ctlio_odometry")
     os.makedirs(a.out, exist_ok=True)
     clean = os.path.join(a.out, "clean")
     bag = os.path.join(a.out, "clean.bag")
@@ -337,9 +392,14 @@ def main():
     if not os.path.isdir(clean):
         subprocess.run([sim, *sim_args, f"--output={clean}"], check=True,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    if not os.path.exists(bag):
-        subprocess.run([sim, *sim_args, "--layout=rosbag", f"--output={bag}"], check=True,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    layouts = [l for l in a.bag_layouts.split(",") if l]
+    clean_bags = {"rosbag": bag, "ros2": os.path.join(a.out, "clean_ros2"),
+                  "ros2_sqlite3": os.path.join(a.out, "clean_ros2_sqlite3")}
+    for layout in layouts:
+        if not os.path.exists(clean_bags[layout]):
+            subprocess.run([sim, *sim_args, f"--layout={layout}",
+                            f"--output={clean_bags[layout]}"], check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     base = [odo, f"--config={a.config}", "--plot=false"]
     rc, log, _, _ = run(base + [f"--dataset={clean}", f"--out={a.out}/clean_run"], a.timeout,
                         os.path.join(a.out, "clean.log"))
@@ -353,9 +413,18 @@ def main():
         cases.append((cls, name, "config", text))
     for cls, name, flags in FLAG_MUTATIONS:
         cases.append((cls, name, "flags", flags))
-    for cls, name, op in bag_mutations(rng, os.path.getsize(bag)):
-        cases.append((cls, name, "bag", op))
+    if "rosbag" in layouts:
+        for cls, name, op in bag_mutations(rng, os.path.getsize(bag)):
+            cases.append((cls, name, "bag", op))
+    for layout, cls in (("ros2", "ros2_mcap"), ("ros2_sqlite3", "ros2_sqlite3")):
+        if layout in layouts:
+            for cls, name, op in ros2_mutations(rng, clean_bags[layout], cls):
+                cases.append((cls, name, layout, op))
     cases = [c for c in cases if a.only in c[0]]
+    if a.reader:
+        cases = [c for c in cases if c[2] not in ("config", "flags")]
+    if a.sample and a.sample < len(cases):
+        cases = [cases[i] for i in sorted(rng.sample(range(len(cases)), a.sample))]
 
     rows = []
     for i, (cls, name, kind, what) in enumerate(cases):
@@ -379,22 +448,43 @@ def main():
         elif kind == "flags":
             args += [f"--dataset={clean}", *what]
             names = [f.split("=")[0].lstrip("-") for f in what]
-        else:
+        elif kind == "bag":
             b = os.path.join(work, "m.bag")
-            data = bytearray(open(bag, "rb").read())
-            if what[0] == "truncate":
-                data = data[:what[1]]
-            else:
-                for pos, val in what[1]:
-                    data[pos] = val
-            open(b, "wb").write(bytes(data))
+            open(b, "wb").write(mutate_bytes(open(bag, "rb").read(), what))
             args.append(f"--dataset={b}")
             names = ["m.bag"]
+        else:
+            d = os.path.join(work, "m_ros2")
+            shutil.copytree(clean_bags[kind], d)
+            f = ros2_storage_file(d)
+            meta = os.path.join(d, "metadata.yaml")
+            if what[0] in ("truncate", "flip"):
+                data = open(f, "rb").read()
+                open(f, "wb").write(mutate_bytes(data, what))
+            elif what[0] == "metadata":
+                if what[1] is None:
+                    os.remove(meta)
+                else:
+                    open(meta, "w").write(what[1])
+            elif what[0] == "metadata_sub":
+                text = open(meta).read()
+                assert what[1][0] in text, what
+                open(meta, "w").write(text.replace(what[1][0], what[1][1]))
+            else:
+                os.remove(f)
+            args.append(f"--dataset={d}")
+            names = ["m_ros2", os.path.basename(f), "metadata.yaml"]
         args.append(f"--out={out_dir}")
+        if a.reader:
+            args = [a.reader, args[-2], "--first=1000000", "--scans=1000000"]
         rc, log, peak, secs = run(args, a.timeout, os.path.join(work, "log.txt"))
         outcome, msg = judge(rc, log, peak, out_dir, names, clean_ate)
+        # Every scan decoded: ctlio_geometry_report then says it had fewer than the 10⁶ asked for.
+        if a.reader and (outcome in ("accurate", "run_failed") or (
+                outcome == "error" and "of the 1000000 sweeps asked for" in log)):
+            outcome = "read"
         rows.append(dict(cls=cls, name=name, outcome=outcome, rc=rc, seconds=f"{secs:.1f}",
-                         message=msg.replace("\n", " ")))
+                         peak_mb=f"{peak:.0f}", message=msg.replace("\n", " ")))
         flag = "  <-- FINDING" if outcome in FINDINGS else ""
         print(f"[{i + 1}/{len(cases)}] {cls:13s} {name:32s} {outcome}{flag}", flush=True)
 
@@ -410,6 +500,9 @@ def main():
     for cls, c in counts.items():
         print(f"{cls:13s} {sum(c.values()):6d}  " +
               ", ".join(f"{k} {v}" for k, v in sorted(c.items())))
+    top = max(rows, key=lambda r: float(r["peak_mb"]))
+    print(f"\npeak resident memory: {top['peak_mb']} MB ({top['cls']} {top['name']}); longest run "
+          f"{max(float(r['seconds']) for r in rows):.1f} s")
     findings = sum(1 for r in rows if r["outcome"] in FINDINGS)
     print(f"\n{len(rows)} mutants, {findings} findings; {a.out}/probe.csv")
     return 1 if findings else 0

@@ -172,6 +172,37 @@ TEST(PointTimeCheck, VerdictPerDefect) {
   }
 }
 
+// A multi-beam lidar: 90 firings of 8 beams, the beams of a firing at one time and azimuth. Its
+// times wrapped by a 16-bit field (every 65.5 µs) span ~59 µs, which a unit factor 1000 would
+// make a 59 ms "sweep"; in time order the firings are scrambled, but the steps between beams of
+// one firing are 0 and made the median step 0 until only steps between different times counted.
+TEST(PointTimeCheck, BeamsSharingAFiringTimeDoNotMakeScrambledTimesLookLikeASweep) {
+  auto firings = [](int64_t wrap, double unit) {
+    PointCloud c;
+    c.stamp_ns = kStamp0;
+    for (int f = 0; f < 90; ++f) {
+      const double a = -2 * M_PI * f / 90;
+      const int64_t t = int64_t(f) * kPeriod / 90;
+      for (int b = 0; b < 8; ++b) {
+        c.points.emplace_back(10 * std::cos(a), 10 * std::sin(a), 0.5 * b - 2.0);
+        c.times_ns.push_back(kStamp0 + std::llround(double(t % wrap) * unit));
+      }
+    }
+    return c;
+  };
+  const int64_t none = int64_t{1} << 62;
+  PointCloud sweep = firings(none, 1.0);
+  EXPECT_EQ(CheckPointTimes(&sweep, kPeriod).verdict, PointTimeCheck::kSweep);
+  PointCloud us = firings(none, 1e-3);  // the same sweep in µs: still rescaled, ties and all
+  const PointTimeCheck r = CheckPointTimes(&us, kPeriod);
+  EXPECT_EQ(r.verdict, PointTimeCheck::kRescaled) << r.reason;
+  EXPECT_EQ(r.factor, 1e3);
+  PointCloud wrapped = firings(65536, 1.0);
+  const PointTimeCheck w = CheckPointTimes(&wrapped, kPeriod);
+  EXPECT_EQ(w.verdict, PointTimeCheck::kNotASweep) << w.reason;
+  EXPECT_NE(w.reason.find("do not follow a scan"), std::string::npos) << w.reason;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bag (sensor_msgs/PointCloud2): x y z float32 + a time field of the given name and datatype.
 

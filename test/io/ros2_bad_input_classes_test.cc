@@ -227,6 +227,67 @@ TEST(Ros2BadInput, PerPointTimesThatCannotBeASweepAreRescaledAndOutliersDropped)
   EXPECT_TRUE(sink.Has(std::string("mem: topic ") + kPoints + ", message 3: dropped 5 of"));
 }
 
+// 8- and 16-bit time fields wrap every 256 ns / 65.5 µs: a driver that narrowed 't' keeps only
+// its low bits (the low bytes of the little-endian uint32, so only the datatype changes here).
+TEST(Ros2BadInput, EightAndSixteenBitTimeFieldsAreRecoveredFromTheAzimuthWithTheirReason) {
+  for (const uint8_t type : {sensor_msgs::PointField::UINT8, sensor_msgs::PointField::UINT16}) {
+    const bool u8 = type == sensor_msgs::PointField::UINT8;
+    SCOPED_TRACE(u8 ? "uint8" : "uint16");
+    MemoryBag bag = SmallBag();
+    EditCloud(&bag, 2, [&](sensor_msgs::PointCloud2* m) {
+      for (auto& f : m->fields) {
+        if (f.name == "t") {
+          ASSERT_EQ(f.datatype, sensor_msgs::PointField::UINT32);
+          f.datatype = type;
+        }
+      }
+    });
+    WarningSink sink;
+    std::unique_ptr<BagSource> s;
+    const auto frames = ReadEverything(bag, &s);
+    EXPECT_EQ(s->retimed_scans(), 1u);
+    EXPECT_EQ(s->unusable_scans(), 0u);
+    EXPECT_TRUE(sink.Has(std::string("mem: topic ") + kPoints + ", message 2: time field"));
+    EXPECT_TRUE(sink.Has(u8 ? "(a uint8 field holds at most 255 units"
+                            : "(a uint16 field holds at most 65535 units"))
+        << sink.text();
+    // The recovered sweep spans most of a period (the wrapped times spanned 256 ns / 65.5 µs).
+    EXPECT_GT(frames[1].end_ns - frames[1].start_ns, 50'000'000);
+  }
+}
+
+// A preset recognised from the topic names while the bag's /tf_static does not connect the IMU
+// and lidar frames is a guess, and the origin and the log say so; the connected tree is not.
+TEST(Ros2BadInput, APresetOverATfTreeThatDoesNotConnectTheFramesIsAGuess) {
+  {
+    WarningSink sink;
+    const auto s = Read(SmallBag());
+    EXPECT_THAT(s->ExtrinsicOrigin(), ::testing::HasSubstr("the bag's /tf_static ("));
+    EXPECT_THAT(sink.text(), ::testing::Not(::testing::HasSubstr("guess")));
+  }
+  MemoryBag bag = SmallBag();
+  Edit<tf2_msgs::TFMessage>(&bag, "/tf_static", 1, [](tf2_msgs::TFMessage* m) {
+    ASSERT_FALSE(m->transforms.empty());
+    for (auto& e : m->transforms) {
+      e.header.frame_id = "base_link";
+      e.child_frame_id = "os_sensor";
+    }
+  });
+  WarningSink sink;
+  const auto s = Read(bag);
+  EXPECT_THAT(s->ExtrinsicOrigin(),
+              ::testing::HasSubstr("preset (recognised from the topic names) — a guess: the "
+                                   "bag's /tf_static does not connect the IMU frame"));
+  EXPECT_THAT(sink.text(), ::testing::HasSubstr("mem: T_imu_lidar from the"));
+  // The preset's extrinsic is the one used (the topic names are the 2021 dataset's).
+  bool used = false;
+  for (const BagPreset& p : BagPresets()) {
+    if (p.name == "newer_college_2021")
+      used = s->ImuFromLidar().Matrix().isApprox(p.imu_from_lidar.Matrix());
+  }
+  EXPECT_TRUE(used);
+}
+
 TEST(Ros2BadInput, ANonFiniteGroundTruthPoseIsAnErrorNamingTheMessage) {
   MemoryBag bag = SmallBag();
   Edit<nav_msgs::Odometry>(&bag, "/ground_truth", 2, [](nav_msgs::Odometry* m) {

@@ -13,6 +13,7 @@
 #include "ctlio/io/bag_writer.h"
 #include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
+#include "ctlio/io/warning_limiter.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "io/ros2_memory_bag.h"
 
@@ -112,6 +113,39 @@ TEST(Ros2BagSource, ACorruptMessageNamesTheBagTopicMessageAndContainerPosition) 
   ExpectError([&] { ReadAll(*read); },
               {"mem: topic /os_cloud_node/imu, message 5 [memory: message ",
                "]: corrupt sensor_msgs/msg/Imu message: linear_acceleration_covariance"});
+}
+
+// An MCAP file cut short (a recording interrupted) is read up to its last complete record; the
+// recovery is an input defect of the run naming the file, and an error under --strict.
+TEST(Ros2BagSource, AnMcapFileCutShortIsAnInputDefectAndAnErrorUnderStrict) {
+  const fs::path dir = testing::FreshTempDir("ros2_cut_mcap");
+  const std::string bag = (dir / "cut").string();
+  {
+    sim::SimulatedSource s(SmallSim());
+    WriteRos2Bag(s, bag);
+  }
+  std::string mcap;
+  for (const auto& e : fs::directory_iterator(bag)) {
+    if (e.path().extension() == ".mcap") mcap = e.path().string();
+  }
+  ASSERT_FALSE(mcap.empty());
+  {
+    BagSource whole(bag);
+    EXPECT_TRUE(whole.InputDefects().empty());
+  }
+  fs::resize_file(mcap, fs::file_size(mcap) * 6 / 10);
+  {
+    BagSource cut(bag);
+    ReadAll(cut);  // what is left is read without an error (here: less than its one chunk)
+    const auto defects = cut.InputDefects();
+    ASSERT_EQ(defects.size(), 1u);
+    EXPECT_EQ(defects[0].kind, "bag file cut short");
+    EXPECT_EQ(defects[0].count, 1u);
+    EXPECT_THAT(defects[0].first, HasSubstr(mcap + ": does not end with the MCAP magic"));
+  }
+  WarningLimiter::SetStrict(true);
+  ExpectError([&] { BagSource strict(bag); }, {mcap, "bag file cut short", "--strict"});
+  WarningLimiter::SetStrict(false);
 }
 
 TEST(Ros2BagSource, TopicsAreChosenAndCheckedWithRos1TypeNames) {

@@ -27,7 +27,10 @@ std::string Seconds(double ns) {
 
 // Whether the points, taken in time order, follow a scan pattern: a spinning lidar's azimuth (or
 // a Livox rosette's) moves on by little between consecutive firings, whereas times that are ring
-// numbers or ranges order the points arbitrarily (median azimuth step near π/2).
+// numbers or ranges order the points arbitrarily (median azimuth step near π/2). Only steps
+// between different times count: the beams of one firing share a time and an azimuth, so with
+// them in, a many-beam cloud whose times were scrambled (a 16-bit field wrapping every 65.5 µs)
+// still had a median step of 0 and was rescaled as if it were a sweep in µs.
 bool FollowsScanPattern(const PointCloud& c) {
   std::vector<size_t> order(c.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -36,12 +39,13 @@ bool FollowsScanPattern(const PointCloud& c) {
   std::vector<double> steps;
   steps.reserve(order.size());
   for (size_t k = 1; k < order.size(); ++k) {
+    if (c.times_ns[order[k]] == c.times_ns[order[k - 1]]) continue;
     const Vec3& p = c.points[order[k - 1]];
     const Vec3& q = c.points[order[k]];
     const double d = std::atan2(q.y(), q.x()) - std::atan2(p.y(), p.x());
     steps.push_back(std::abs(std::remainder(d, 2 * M_PI)));
   }
-  return Quantile(&steps, 0.5) < 0.3;
+  return !steps.empty() && Quantile(&steps, 0.5) < 0.3;
 }
 
 }  // namespace

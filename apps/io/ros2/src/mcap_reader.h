@@ -35,6 +35,12 @@ class McapReader : public StorageReader {
   void SetFilter(const std::vector<bool>& wanted) override { wanted_ = wanted; }
   bool Next(Ros2Message* message) override;
   std::string Where() const override { return where_; }
+  std::string Recovered() const override {
+    return truncated_ ? path_ +
+                            ": does not end with the MCAP magic (recording interrupted?): "
+                            "read up to its last complete record"
+                      : "";
+  }
 
  private:
   struct Block {

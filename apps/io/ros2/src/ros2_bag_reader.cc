@@ -42,6 +42,7 @@ struct Ros2BagReader::Impl {
   std::unique_ptr<StorageReader> reader;
   uint64_t bytes = 0;
   std::string last_where;  // of the last message, once its file is closed
+  std::vector<std::string> recovered;
 
   void Merge(size_t file, const std::vector<Ros2Topic>& file_topics) {
     for (const Ros2Topic& t : file_topics) {
@@ -111,6 +112,7 @@ Ros2BagReader::Ros2BagReader(const std::string& path) : impl_(std::make_unique<I
   for (size_t f = 0; f < m.files.size(); ++f) {
     auto reader = OpenStorage(m.files[f]);
     m.Merge(f, reader->topics());
+    if (std::string r = reader->Recovered(); !r.empty()) m.recovered.push_back(std::move(r));
     if (f == 0) m.reader = std::move(reader);
   }
   // The recorder's counts where the storage gives none (SQLite); topics listed only there too.
@@ -166,6 +168,8 @@ bool Ros2BagReader::Next(Ros2Message* message) {
 }
 
 uint64_t Ros2BagReader::bytes_read() const { return impl_->bytes; }
+
+const std::vector<std::string>& Ros2BagReader::recovered() const { return impl_->recovered; }
 
 std::string Ros2BagReader::Where() const {
   if (impl_->reader) return impl_->reader->Where();

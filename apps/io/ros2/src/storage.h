@@ -23,6 +23,8 @@ class StorageReader {
   // The next message in log-time order (ties in file order); `message->topic` is the file's index.
   virtual bool Next(Ros2Message* message) = 0;
   virtual std::string Where() const = 0;
+  // What the reader recovered from when it opened the file ("" if nothing): a file cut short.
+  virtual std::string Recovered() const { return ""; }
 };
 
 std::unique_ptr<StorageReader> OpenMcap(const std::string& path);

@@ -118,6 +118,9 @@ BagSource::BagSource(const std::string& path, std::unique_ptr<BagStream> stream,
 }
 
 void BagSource::Impl::Open() {
+  // A container recovered from (an MCAP file cut short, read up to its last complete record) is
+  // an input defect of the run (evaluation.txt) and, under --strict, an error.
+  for (const std::string& r : stream->Recovered()) warnings->Count("bag file cut short", r);
   const std::map<std::string, std::string> topics = stream->Topics();
   if (!options.preset.empty()) {
     for (const BagPreset& p : BagPresets()) {

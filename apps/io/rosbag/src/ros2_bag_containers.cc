@@ -15,6 +15,7 @@ class ReaderContainer : public Ros2Container {
   }
   bool Next(ros2::Ros2Message* message) override { return reader_.Next(message); }
   std::string Where() const override { return reader_.Where(); }
+  std::vector<std::string> Recovered() const override { return reader_.recovered(); }
 
  private:
   ros2::Ros2BagReader reader_;

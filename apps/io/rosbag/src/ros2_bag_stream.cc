@@ -15,13 +15,18 @@ namespace {
 class Ros2BagStream : public BagStream {
  public:
   Ros2BagStream(const std::string& path, Ros2ContainerOpener open)
-      : path_(path), open_(std::move(open)), container_(open_()) {
+      : path_(path),
+        open_(std::move(open)),
+        container_(open_()),
+        recovered_(container_->Recovered()) {
     for (const ros2::Ros2Topic& t : container_->topics()) {
       topics_.emplace(t.name, ros2::Ros1TypeName(t.type));  // the first type a name has
     }
   }
 
   std::string Kind() const override { return "ros2bag"; }
+  // The first opening's (every pass opens the same files again).
+  std::vector<std::string> Recovered() const override { return recovered_; }
   std::map<std::string, std::string> Topics() const override { return topics_; }
   size_t MessageCount(const std::string& topic) override {
     size_t n = 0;
@@ -92,6 +97,7 @@ class Ros2BagStream : public BagStream {
   std::string path_;
   Ros2ContainerOpener open_;
   std::unique_ptr<Ros2Container> container_;
+  std::vector<std::string> recovered_;
   std::map<std::string, std::string> topics_;
   ros2::Ros2Message message_;
   bool started_ = false, empty_ = false;

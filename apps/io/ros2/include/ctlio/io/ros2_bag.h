@@ -61,6 +61,8 @@ class Ros2BagReader {
   // Where the last message returned came from ("<file>: message 12 (chunk at byte 4096)"), for
   // errors raised by the decoders.
   std::string Where() const;
+  // What was recovered from when the files were opened, one line each (a file cut short).
+  const std::vector<std::string>& recovered() const;
 
  private:
   struct Impl;

@@ -48,6 +48,8 @@ class BagStream {
   virtual void Read(const std::string& where, nav_msgs::Odometry* msg) = 0;
   virtual void Read(const std::string& where, geometry_msgs::PoseStamped* msg) = 0;
   virtual void Read(const std::string& where, livox::CustomMsg* msg) = 0;
+  // What the container recovered from when it was opened (a file cut short), one line each.
+  virtual std::vector<std::string> Recovered() const { return {}; }
 };
 
 // A ROS 1 bag file (checked by CheckBagStructure first). Throws naming `path`.
@@ -62,6 +64,7 @@ class Ros2Container {
   virtual void SetTopicFilter(const std::vector<size_t>& topics) = 0;
   virtual bool Next(ros2::Ros2Message* message) = 0;
   virtual std::string Where() const = 0;
+  virtual std::vector<std::string> Recovered() const { return {}; }
 };
 // Opens the container at its first message (called once for the topics and once per pass).
 using Ros2ContainerOpener = std::function<std::unique_ptr<Ros2Container>()>;
