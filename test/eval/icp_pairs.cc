@@ -59,6 +59,7 @@
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
+#include "loam_features.h"
 
 namespace ctlio::icp_pairs {
 
@@ -72,11 +73,19 @@ std::vector<Vec3> ReadSweep(const std::string& spec) {
   return out;
 }
 
-// LOAM-like features of a sweep, to compare with the real Newer College features (planes ≈ 31 %,
-// edges ≈ 2 % of an OS1-64 sweep's points): along each ring in firing order, the curvature
-// |Σ_{j=−5..5} (p_{i+j} − p_i)| / |p_i|; per ring the flattest 31 % as planes and the sharpest 2 %
-// as edges. Returns the indices kept.
+// LOAM features of a sweep (loam_features.h: smoothness along each ring, capped per sector, the
+// "less sharp" edges and "less flat" planes, as the real Newer College features are). With
+// ICP_PROPORTIONAL_FEATURES=1 the earlier imitation of the real files' proportions instead: per
+// ring the flattest 31 % and sharpest 2 % by |Σ_{j=−5..5} (p_{i+j} − p_i)| / |p_i|. Returns the
+// indices kept.
 std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c) {
+  if (std::getenv("ICP_PROPORTIONAL_FEATURES") == nullptr) {
+    const LoamFeatures f = SelectLoamFeatures(c.points, c.ring);
+    std::vector<size_t> keep = f.edges;
+    keep.insert(keep.end(), f.planes.begin(), f.planes.end());
+    std::sort(keep.begin(), keep.end());
+    return keep;
+  }
   std::map<int, std::vector<size_t>> rings;
   for (size_t i = 0; i < c.size(); ++i) rings[c.ring.empty() ? 0 : c.ring[i]].push_back(i);
   std::vector<size_t> keep;

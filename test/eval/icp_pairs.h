@@ -12,7 +12,8 @@ namespace ctlio::icp_pairs {
 
 // float32 x y z files; "a+b" joins two.
 std::vector<Vec3> ReadSweep(const std::string& spec);
-// LOAM-like features of a sweep (indices kept): the flattest 31 % and sharpest 2 % per ring.
+// LOAM features of a sweep (indices kept; loam_features.h), or with ICP_PROPORTIONAL_FEATURES=1
+// the flattest 31 % and sharpest 2 % per ring.
 std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c);
 // ICP_SHAKE_SCALE, ICP_RELIEF, ICP_GRASS_RELIEF.
 void ApplyWorldOverrides(sim::SimConfig* c);

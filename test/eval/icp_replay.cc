@@ -13,6 +13,7 @@
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/presets.h"
 #include "icp_pairs.h"
+#include "loam_features.h"
 
 namespace ctlio::icp_pairs {
 namespace {
@@ -141,6 +142,9 @@ int Replay(int argc, char** argv) {
       const sim::LidarInertialSim s(still);
       const io::PointCloud cloud = s.Scan(1);
       const double clearance = s.CastRay(lidar.translation(), -Vec3::UnitZ());
+      size_t edges = 0;
+      if (!raw && std::getenv("ICP_PROPORTIONAL_FEATURES") == nullptr)
+        edges = SelectLoamFeatures(cloud.points, cloud.ring).edges.size();
       if (raw) {
         kept[k] = cloud.points;
       } else {
@@ -151,8 +155,8 @@ int Replay(int argc, char** argv) {
           "place %d (t %.0f s, at %.0f %.0f m) keyframe %d: %zu points in the sweep, %.2f m "
           "above "
           "ground; "
-          "kept %s\n",
-          p, t, at.x(), at.y(), k, cloud.size(), clearance, Describe(kept[k]).c_str());
+          "kept %s (%zu edges)\n",
+          p, t, at.x(), at.y(), k, cloud.size(), clearance, Describe(kept[k]).c_str(), edges);
     }
     for (size_t q = 0; q < ij.size(); ++q) {
       const auto [i, j] = ij[q];
