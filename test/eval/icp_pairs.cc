@@ -51,6 +51,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 
@@ -78,9 +79,22 @@ std::vector<Vec3> ReadSweep(const std::string& spec) {
 // ICP_PROPORTIONAL_FEATURES=1 the earlier imitation of the real files' proportions instead: per
 // ring the flattest 31 % and sharpest 2 % by |Σ_{j=−5..5} (p_{i+j} − p_i)| / |p_i|. Returns the
 // indices kept.
+// ICP_LOAM_LESS_SHARP=n: n edge points per sector at most instead of LOAM's 20 (the real files
+// hold about 1.3 k edges per sweep, which the reference parameters do not give here).
+LoamFeatureOptions LoamOptionsFromEnvironment() {
+  LoamFeatureOptions o;
+  if (const char* n = std::getenv("ICP_LOAM_LESS_SHARP")) {
+    o.less_sharp_per_sector = std::atoi(n);
+    if (o.less_sharp_per_sector < 0)
+      throw std::invalid_argument("ICP_LOAM_LESS_SHARP must be a non-negative integer");
+    o.sharp_per_sector = std::min(o.sharp_per_sector, o.less_sharp_per_sector);
+  }
+  return o;
+}
+
 std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c) {
   if (std::getenv("ICP_PROPORTIONAL_FEATURES") == nullptr) {
-    const LoamFeatures f = SelectLoamFeatures(c.points, c.ring);
+    const LoamFeatures f = SelectLoamFeatures(c.points, c.ring, LoamOptionsFromEnvironment());
     std::vector<size_t> keep = f.edges;
     keep.insert(keep.end(), f.planes.begin(), f.planes.end());
     std::sort(keep.begin(), keep.end());

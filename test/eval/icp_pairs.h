@@ -7,6 +7,7 @@
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/manifolds/se3.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
+#include "loam_features.h"
 
 namespace ctlio::icp_pairs {
 
@@ -15,6 +16,8 @@ std::vector<Vec3> ReadSweep(const std::string& spec);
 // LOAM features of a sweep (indices kept; loam_features.h), or with ICP_PROPORTIONAL_FEATURES=1
 // the flattest 31 % and sharpest 2 % per ring.
 std::vector<size_t> LoamLikeFeatures(const io::PointCloud& c);
+// The LOAM selection's options with ICP_LOAM_LESS_SHARP applied.
+LoamFeatureOptions LoamOptionsFromEnvironment();
 // ICP_SHAKE_SCALE, ICP_RELIEF, ICP_GRASS_RELIEF.
 void ApplyWorldOverrides(sim::SimConfig* c);
 // ICP_EFFECT_ONLY, ICP_EFFECT_DROP.

@@ -144,7 +144,8 @@ int Replay(int argc, char** argv) {
       const double clearance = s.CastRay(lidar.translation(), -Vec3::UnitZ());
       size_t edges = 0;
       if (!raw && std::getenv("ICP_PROPORTIONAL_FEATURES") == nullptr)
-        edges = SelectLoamFeatures(cloud.points, cloud.ring).edges.size();
+        edges =
+            SelectLoamFeatures(cloud.points, cloud.ring, LoamOptionsFromEnvironment()).edges.size();
       if (raw) {
         kept[k] = cloud.points;
       } else {
