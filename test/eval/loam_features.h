@@ -1,6 +1,7 @@
 // LOAM feature selection (Zhang & Singh, RSS 2014, Sec. V-A) for the icp_pairs experiment: edge and
-// planar points picked per scan line from the smoothness of each point along its line, as the real
-// Newer College 01 feature files were made. Not a library.
+// planar points picked per scan line from the smoothness of each point along its line, the scheme
+// the real Newer College 01 feature files are named after (their extractor's parameters are not
+// stated). Not a library.
 #pragma once
 
 #include <cstddef>
