@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <functional>
+#include <utility>
 
 #include "common/sim_lio.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -33,6 +35,22 @@ lioapp::RunSummary RunWithScale(LioMethod m, double scale, bool adaptive = false
   config.pose_covariance_lidar_floor_rad = floor_rad;
   sim::SimulatedSource source(c);
   return lioapp::RunOdometry(source, config, lioapp::RunOptions{});
+}
+
+// The same short run twice with the pose covariance on (not adaptive): as configured, then with
+// `change` applied.
+std::pair<lioapp::RunSummary, lioapp::RunSummary> RunBeforeAndAfter(
+    LioMethod m, const std::function<void(OdometryConfig*)>& change) {
+  const sim::SimConfig c = testing::ShortSparseSequence();
+  OdometryConfig config = testing::SimLioConfig();
+  config.method = m;
+  config.pose_covariance = true;
+  config.pose_covariance_adaptive = false;
+  sim::SimulatedSource a_source(c), b_source(c);
+  lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
+  change(&config);
+  lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+  return {std::move(a), std::move(b)};
 }
 
 TEST(CovarianceLidarScale, SameEstimateCovarianceWithinTheBounds) {
@@ -121,16 +139,10 @@ TEST(CovarianceLidarFloor, SameEstimateOwnCovariance) {
 // (a left perturbation in the map frame), for both methods; the estimates bit for bit.
 TEST(CovarianceMapError, AddsTheMapCovariance) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
-    const sim::SimConfig c = testing::ShortSparseSequence();
-    OdometryConfig config = testing::SimLioConfig();
-    config.method = m;
-    config.pose_covariance = true;
-    config.pose_covariance_adaptive = false;
-    sim::SimulatedSource a_source(c), b_source(c);
-    const lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
-    config.pose_covariance_map_sigma_m = 0.03;
-    config.pose_covariance_map_sigma_rad = 0.002;
-    const lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+    const auto [a, b] = RunBeforeAndAfter(m, [](OdometryConfig* config) {
+      config->pose_covariance_map_sigma_m = 0.03;
+      config->pose_covariance_map_sigma_rad = 0.002;
+    });
     ASSERT_EQ(a.scans.size(), b.scans.size());
     const Mat6 map = (Vec6() << 9e-4, 9e-4, 9e-4, 4e-6, 4e-6, 4e-6).finished().asDiagonal();
     int compared = 0;
@@ -152,15 +164,8 @@ TEST(CovarianceMapError, AddsTheMapCovariance) {
 // scans register against the exact first map) and only grows (each scan adds g·β²·Σ_rel ≥ 0).
 TEST(CovarianceMapGrowth, SameEstimateCovariancePlusAGrowingMapError) {
   for (const LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput}) {
-    const sim::SimConfig c = testing::ShortSparseSequence();
-    OdometryConfig config = testing::SimLioConfig();
-    config.method = m;
-    config.pose_covariance = true;
-    config.pose_covariance_adaptive = false;
-    sim::SimulatedSource a_source(c), b_source(c);
-    const lioapp::RunSummary a = lioapp::RunOdometry(a_source, config, lioapp::RunOptions{});
-    config.pose_covariance_map_growth = 1.0;
-    const lioapp::RunSummary b = lioapp::RunOdometry(b_source, config, lioapp::RunOptions{});
+    const auto [a, b] = RunBeforeAndAfter(
+        m, [](OdometryConfig* config) { config->pose_covariance_map_growth = 1.0; });
     ASSERT_EQ(a.scans.size(), b.scans.size());
     Mat6 previous = Mat6::Zero();
     int compared = 0, grew = 0;
