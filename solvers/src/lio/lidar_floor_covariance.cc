@@ -97,15 +97,9 @@ std::optional<Mat6> FlooredLidarPoseCovariance(const SlidingWindow& window, Stat
                                                const std::vector<ceres::ResidualBlockId>& lidar,
                                                double lidar_scale, const Vec6& floor_sigma,
                                                const SE3& T_mr, const Mat6& tangent_from_body) {
-  std::optional<Layout> layout = LayoutWithoutLidar(window, pose, lidar);
-  if (!layout) return std::nullopt;
-  Layout& l = *layout;
-  const Eigen::MatrixXd H =
-      FlooredInformationMatrix(window, l.ordering, l.blocks, l.pose_offset, lidar, lidar_scale,
-                               floor_sigma, tangent_from_body);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return std::nullopt;
-  return NewestPose(ldlt, l.n, l.pose_offset, T_mr, tangent_from_body);
+  // A recursion that has carried nothing yet uses the window's prior: this scan alone.
+  return FlooredPoseCovariance().Compute(window, pose, {}, lidar, lidar_scale, floor_sigma, T_mr,
+                                         tangent_from_body);
 }
 
 std::optional<Mat6> FlooredPoseCovariance::Compute(const SlidingWindow& window, StateId pose,
