@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "common/write_temp.h"
 #include "ctlio/factors/imu/gravity_initialization.h"
 #include "ctlio/factors/imu/imu_data.h"
 #include "ctlio/factors/imu/preintegrated_imu.h"
@@ -255,11 +256,7 @@ TEST(GravityInitialization, ExplainsWhyItRejects) {
 }
 
 // Malformed files: the error names the file and the line.
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + name;
-  std::ofstream(path) << text;
-  return path;
-}
+using ctlio::testing::WriteTemp;
 
 void ExpectReadError(const std::string& path, const std::string& needle) {
   try {

@@ -11,16 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "common/write_temp.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lio {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
+using ctlio::testing::WriteTemp;
 
 // The error LoadOdometryConfig(spec) throws ("no error" when it loads).
 std::string LoadError(const std::string& spec) {

@@ -8,16 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "common/write_temp.h"
 #include "ctlio/solvers/lio/config_composition.h"
 
 namespace ctlio::lio {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
+using ctlio::testing::WriteTemp;
 
 TEST(OdometryConfig, DefaultAccelerometerModelIsTheExactOne) {
   // The paper's body-centric model (false) is chosen explicitly; an empty config keeps the exact

@@ -6,16 +6,13 @@
 
 #include <fstream>
 
+#include "common/write_temp.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lio {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
+using ctlio::testing::WriteTemp;
 
 // Expects LoadOdometryConfig(text) to throw naming the file, `line` and `needle`.
 void ExpectError(const std::string& name, const std::string& text, int line,
