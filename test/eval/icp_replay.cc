@@ -25,20 +25,40 @@ std::string Describe(const std::vector<Vec3>& points) {
   std::vector<double> range;
   std::map<std::tuple<int, int, int>, int> voxels;
   int low = 0;
+  // Above the ground: how many of 12 azimuth sectors of 30° hold at least 20 such points within
+  // 30 m, and the median horizontal range of those points (what fixes the horizontal motion).
+  int sector_points[12] = {0};
+  std::vector<double> upright_range;
   for (const Vec3& p : points) {
     range.push_back(p.norm());
     ++voxels[{int(std::floor(p.x() / 0.5)), int(std::floor(p.y() / 0.5)),
               int(std::floor(p.z() / 0.5))}];
     low += p.z() < -1.0;
+    const double r = std::hypot(p.x(), p.y());
+    if (p.z() >= -1.0) {
+      upright_range.push_back(r);
+      if (r < 30.0) {
+        const int k = int(std::floor((std::atan2(p.y(), p.x()) + M_PI) / (M_PI / 6.0)));
+        ++sector_points[std::clamp(k, 0, 11)];
+      }
+    }
   }
   if (range.empty()) return "no points";
   std::nth_element(range.begin(), range.begin() + range.size() / 2, range.end());
-  char text[160];
+  int sectors = 0;
+  for (const int n : sector_points) sectors += n >= 20;
+  double upright_median = 0.0;
+  if (!upright_range.empty()) {
+    std::nth_element(upright_range.begin(), upright_range.begin() + upright_range.size() / 2,
+                     upright_range.end());
+    upright_median = upright_range[upright_range.size() / 2];
+  }
+  char text[240];
   std::snprintf(text, sizeof(text),
                 "%zu points, %zu voxels of 0.5 m, median range %.1f m, %.0f %% "
-                "below z -1 m",
+                "below z -1 m; above it: %d of 12 sectors within 30 m, median range %.1f m",
                 points.size(), voxels.size(), range[range.size() / 2],
-                100.0 * low / double(points.size()));
+                100.0 * low / double(points.size()), sectors, upright_median);
   return text;
 }
 

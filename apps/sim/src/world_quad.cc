@@ -4,6 +4,7 @@
 
 #include "ctlio/sim/random_draw.h"
 #include "ctlio/sim/worlds.h"
+#include "quad_park.h"
 #include "world_content.h"
 
 namespace ctlio::sim {
@@ -119,6 +120,8 @@ World BuildQuadWorld(const QuadParams& p, uint64_t seed) {
     const double speed = U(0.9, 1.6), phase = U(0, 100);
     if (clear_lane(a, b)) s.movers.push_back({a, b, speed, phase, 0.22, U(1.6, 1.85)});
   }
+  // The park's rim, path furniture and mound, from their own generator (quad_park.h).
+  FurnishPark(s, world.path, {park_x0, park_y0, park_x1, park_y1}, seed);
   s.Build(4.0);
   world.start_range = world.path.Length();
   world.max_speed = 2.5;
