@@ -260,18 +260,29 @@ double LidarFrontend::NextVoxelSize() const {
   return num_scans_ < options_.initial_scans ? options_.initial_voxel_size : options_.voxel_size;
 }
 
-bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
-  const size_t n = neighbours.size();
-  if (n < 3) return false;
-  Vec3 mean = Vec3::Zero();
-  for (const auto& nb : neighbours) mean += nb.point;
-  mean /= static_cast<double>(n);
-  Mat3 cov = Mat3::Zero();
+namespace {
+
+// Mean and (population) covariance of the neighbours' points; n > 0.
+void MomentsOf(const std::vector<VoxelMap::Neighbour>& neighbours, Vec3* mean, Mat3* covariance) {
+  const double n = static_cast<double>(neighbours.size());
+  *mean = Vec3::Zero();
+  for (const auto& nb : neighbours) *mean += nb.point;
+  *mean /= n;
+  *covariance = Mat3::Zero();
   for (const auto& nb : neighbours) {
-    const Vec3 d = nb.point - mean;
-    cov.noalias() += d * d.transpose();
+    const Vec3 d = nb.point - *mean;
+    covariance->noalias() += d * d.transpose();
   }
-  cov /= static_cast<double>(n);
+  *covariance /= n;
+}
+
+}  // namespace
+
+bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
+  if (neighbours.size() < 3) return false;
+  Vec3 mean;
+  Mat3 cov;
+  MomentsOf(neighbours, &mean, &cov);
   return FitPlaneFromMoments(mean, cov, plane);
 }
 
@@ -316,14 +327,9 @@ bool PlaneAssociator::FitAcrossLine(const Vec3& p_map, PlaneFit* plane) {
   // The line's direction is the neighbours' largest principal axis; the two axes across it (the
   // fit's normal and its middle axis) are where another ring of the same surface can lie, one
   // ring spacing (1–2 m for a VLP-16's floor) away on either side.
-  Vec3 mean = Vec3::Zero();
-  for (const auto& nb : neighbours_) mean += nb.point;
-  mean /= static_cast<double>(neighbours_.size());
-  Mat3 covariance = Mat3::Zero();
-  for (const auto& nb : neighbours_) {
-    const Vec3 d = nb.point - mean;
-    covariance.noalias() += d * d.transpose();
-  }
+  Vec3 mean;
+  Mat3 covariance;
+  MomentsOf(neighbours_, &mean, &covariance);
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(covariance);
   if (es.info() != Eigen::Success) return false;
