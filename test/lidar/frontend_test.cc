@@ -120,6 +120,56 @@ TEST(Frontend, AssociationGate) {
   EXPECT_FALSE(associator.Associate(q, Vec3(0.3, 0.2, 2.5), &a));
 }
 
+// line_neighbourhood_ratio: a VLP-16's map seen from one place is rings on the floor, here two
+// arcs of radius 8.0 and 9.3 m (the spacing of neighbouring beams at that range) with ±1 cm
+// relief. The 20 nearest points of a point on the inner ring are that ring, a line whose plane
+// is noise (planarity weight ≈ 0); fitted across the line, the plane takes in the outer ring and
+// is the floor. A ring with no other within reach gives no association; a plane neighbourhood is
+// associated as without the option.
+TEST(Frontend, LineNeighbourhoodIsFittedAcrossToTheNextRing) {
+  LidarFrontendOptions off;
+  LidarFrontendOptions on;
+  on.line_neighbourhood_ratio = 0.1;
+  const auto ring = [](VoxelMap* map, double radius) {
+    int n = 0;
+    for (double a = -0.4; a <= 0.4; a += 0.1 / radius, ++n) {
+      const double relief_z = n % 2 ? 0.01 : -0.01;
+      const double relief_r = n % 3 == 0 ? 0.01 : -0.005;
+      map->Insert(
+          Vec3((radius + relief_r) * std::cos(a), (radius + relief_r) * std::sin(a), relief_z));
+    }
+  };
+  VoxelMap two_rings(LidarFrontend::MapOptions(off));
+  ring(&two_rings, 8.0);
+  ring(&two_rings, 9.3);
+  const Vec3 q(1.0, 2.0, 3.0);
+  const Vec3 p(8.0, 0.05, 0.02);
+  PlaneAssociation line, across;
+  ASSERT_TRUE(PlaneAssociator(two_rings, off).Associate(q, p, &line));
+  EXPECT_LT(line.weight, 0.01);
+  ASSERT_TRUE(PlaneAssociator(two_rings, on).Associate(q, p, &across));
+  EXPECT_GT(std::abs(across.plane_normal.z()), 0.999);
+  EXPECT_GT(across.weight, 0.3);
+  EXPECT_NEAR(across.plane_point.z(), 0.0, 0.005);
+  EXPECT_GT(across.plane_point.x(), 8.1);  // both rings in the fit
+  // The outer ring 3 m away (beyond two map voxels): still a line, no association.
+  VoxelMap far_rings(LidarFrontend::MapOptions(off));
+  ring(&far_rings, 8.0);
+  ring(&far_rings, 11.0);
+  EXPECT_TRUE(PlaneAssociator(far_rings, off).Associate(q, p, &line));
+  EXPECT_FALSE(PlaneAssociator(far_rings, on).Associate(q, p, &across));
+  // A plane neighbourhood is no line: the same association with the option as without.
+  VoxelMap plane(LidarFrontend::MapOptions(off));
+  for (double x = -5; x <= 5; x += 0.25)
+    for (double y = -5; y <= 5; y += 0.25) plane.Insert(Vec3(x, y, 0.0));
+  const Vec3 r(0.3, 0.2, 0.4);
+  ASSERT_TRUE(PlaneAssociator(plane, off).Associate(q, r, &line));
+  ASSERT_TRUE(PlaneAssociator(plane, on).Associate(q, r, &across));
+  EXPECT_EQ(line.plane_point, across.plane_point);
+  EXPECT_EQ(line.plane_normal, across.plane_normal);
+  EXPECT_EQ(line.weight, across.weight);
+}
+
 // The voxel-plane association answers from the map's per-voxel plane where the voxel holds
 // min_neighbours points, and falls back to the kNN plane where it does not.
 TEST(Frontend, VoxelPlaneAssociationAndFallback) {
@@ -381,6 +431,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.association, "knn");
   EXPECT_EQ(o.association, d.association);
   EXPECT_EQ(o.voxel_plane_max_thickness, d.voxel_plane_max_thickness);
+  EXPECT_EQ(o.line_neighbourhood_ratio, 0.0);
+  EXPECT_EQ(o.line_neighbourhood_ratio, d.line_neighbourhood_ratio);
   EXPECT_EQ(o.threads, 1);
   EXPECT_EQ(o.threads, d.threads);
 }
@@ -407,6 +459,13 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("residual_blocks: point\n")).residual_blocks,
             "point");
   EXPECT_NE(ErrorOf("threads: 0\n").find("threads"), std::string::npos);
+  EXPECT_NE(ErrorOf("line_neighbourhood_ratio: 1.0\n").find("line_neighbourhood_ratio"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("line_neighbourhood_ratio: -0.1\n").find("line_neighbourhood_ratio"),
+            std::string::npos);
+  EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("line_neighbourhood_ratio: 0.1\n"))
+                .line_neighbourhood_ratio,
+            0.1);
   EXPECT_NE(ErrorOf("reassociation_distance: -0.1\n").find("reassociation_distance"),
             std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);

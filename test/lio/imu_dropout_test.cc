@@ -207,15 +207,17 @@ TEST(ImuDropout, DegenerateDirectionsInAnOutageKeepThePrediction) {
 // states return to the prediction and its lidar residuals leave the window: the next scans start
 // from the prediction. lidar_only, VLP-16 model and its shipped config, park walk 100 (a tuning
 // index), 1.5 s: the third scan jumps. Measured over 10 s: 95 of 100 scans failed without the
-// restore (every scan after the jump), 1 failed and ATE 0.07 m with it.
+// restore (every scan after the jump), 1 failed and ATE 0.07 m with it. The front end's
+// line-neighbourhood fit (vlp16.yaml's line_neighbourhood_ratio) registers that scan without the
+// jump, so it is off here: the test is about the restore, not about the front end.
 TEST(ImuDropout, LidarOnlyStartsAgainFromThePredictionAfterADivergedScan) {
   sim::SimConfig seq = sim::ExperimentConfig(sim::Regime::kWalking, 100, sim::kExperimentSeed,
                                              sim::WorldKind::kPark);
   sim::ApplySensorModel(sim::FindSensorModel("vlp16"), &seq);
   seq.duration_s = 1.5;
-  const OdometryConfig c =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml")
-          .ForMethod(LioMethod::kLidarOnly);
+  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml")
+                         .ForMethod(LioMethod::kLidarOnly);
+  c.frontend.line_neighbourhood_ratio = 0.0;
   sim::SimulatedSource source(seq);
   const lioapp::RunSummary run = lioapp::RunOdometry(source, c);
   int first_failed = -1;

@@ -121,8 +121,12 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   const OdometryConfig v =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml");
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.0025);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.001);
   EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
+  // The line-neighbourhood plane fit is both methods' (vlp16.yaml's lidar_frontend).
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.line_neighbourhood_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.001);
   const OdometryConfig nc =
       LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
   EXPECT_DOUBLE_EQ(nc.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 1.0);

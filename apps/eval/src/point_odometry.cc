@@ -1,12 +1,11 @@
 #include "ctlio/eval/point_odometry.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_set>
 
+#include "ctlio/eval/point_to_point.h"
 #include "ctlio/manifolds/so3.h"
 
 namespace ctlio::eval {
@@ -20,16 +19,6 @@ std::array<int64_t, 3> VoxelOf(const Vec3& p, double voxel) {
 uint64_t Key(const std::array<int64_t, 3>& v) {
   return (uint64_t(v[0]) & 0x1FFFFF) | (uint64_t(v[1]) & 0x1FFFFF) << 21 |
          (uint64_t(v[2]) & 0x1FFFFF) << 42;
-}
-
-// One original point per voxel, the first (as KISS-ICP keeps).
-std::vector<Vec3> FirstPerVoxel(const std::vector<Vec3>& points, double voxel) {
-  std::unordered_set<uint64_t> seen;
-  std::vector<Vec3> out;
-  for (const Vec3& p : points) {
-    if (seen.insert(Key(VoxelOf(p, voxel))).second) out.push_back(p);
-  }
-  return out;
 }
 
 }  // namespace
@@ -95,25 +84,19 @@ SE3 PointOdometry::Align(const std::vector<Vec3>& source, const SE3& previous, c
   const Mat3 R = previous.rotation();
   SE3 T = initial;
   for (int it = 0; it < options_.iterations; ++it) {
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Vec6 g = Vec6::Zero();
-    int used = 0;
+    PointToPointSystem system;
     for (const Vec3& s : source) {
       const Vec3 q = T * s;
       const Vec3 p = previous * q;
       const Vec3* m = Nearest(p, gate);
       if (m == nullptr) continue;
       const Vec3 e = p - *m;
-      // Geman–McClure as KISS-ICP writes it (point_icp.h): w = κ² / (κ + |e|²)².
-      const double w = kernel * kernel / ((kernel + e.squaredNorm()) * (kernel + e.squaredNorm()));
       Eigen::Matrix<double, 3, 6> J;
       J << R, -R * so3::Hat(q);
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * e;
-      ++used;
+      system.Add(e, J, kernel);
     }
-    if (used < 6) break;
-    const Vec6 delta = -H.ldlt().solve(g);
+    if (system.used() < 6) break;
+    const Vec6 delta = system.Step();
     if (!delta.allFinite()) break;
     T = SE3::Exp(delta) * T;
     if (delta.norm() < options_.converged) break;
@@ -137,13 +120,13 @@ SE3 PointOdometry::Register(const std::vector<Vec3>& points, const std::vector<d
     deskewed.push_back(options_.deskew ? SE3::Exp((times[i] / period) * xi) * points[i]
                                        : points[i]);
   }
-  const std::vector<Vec3> frame = FirstPerVoxel(deskewed, 0.5 * options_.map_voxel);
+  const std::vector<Vec3> frame = FirstPointPerVoxel(deskewed, 0.5 * options_.map_voxel);
   SE3 pose = first_;
   double sigma = 0.0;
   if (k > 0) {
     sigma = options_.fixed_sigma > 0.0 ? options_.fixed_sigma : threshold_.Sigma();
     const SE3 relative =
-        Align(FirstPerVoxel(frame, options_.source_voxel), poses_[k - 1], delta, sigma);
+        Align(FirstPointPerVoxel(frame, options_.source_voxel), poses_[k - 1], delta, sigma);
     // The prediction's error, D = (T_{k−1}·Δ)⁻¹·T_k = Δ⁻¹·relative.
     threshold_.Update(delta.Inverse() * relative);
     pose = poses_[k - 1] * relative;

@@ -1,5 +1,6 @@
 #include "ctlio/solvers/lio/frontend.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -259,18 +260,29 @@ double LidarFrontend::NextVoxelSize() const {
   return num_scans_ < options_.initial_scans ? options_.initial_voxel_size : options_.voxel_size;
 }
 
-bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
-  const size_t n = neighbours.size();
-  if (n < 3) return false;
-  Vec3 mean = Vec3::Zero();
-  for (const auto& nb : neighbours) mean += nb.point;
-  mean /= static_cast<double>(n);
-  Mat3 cov = Mat3::Zero();
+namespace {
+
+// Mean and (population) covariance of the neighbours' points; n > 0.
+void MomentsOf(const std::vector<VoxelMap::Neighbour>& neighbours, Vec3* mean, Mat3* covariance) {
+  const double n = static_cast<double>(neighbours.size());
+  *mean = Vec3::Zero();
+  for (const auto& nb : neighbours) *mean += nb.point;
+  *mean /= n;
+  *covariance = Mat3::Zero();
   for (const auto& nb : neighbours) {
-    const Vec3 d = nb.point - mean;
-    cov.noalias() += d * d.transpose();
+    const Vec3 d = nb.point - *mean;
+    covariance->noalias() += d * d.transpose();
   }
-  cov /= static_cast<double>(n);
+  *covariance /= n;
+}
+
+}  // namespace
+
+bool FitPlane(const std::vector<VoxelMap::Neighbour>& neighbours, PlaneFit* plane) {
+  if (neighbours.size() < 3) return false;
+  Vec3 mean;
+  Mat3 cov;
+  MomentsOf(neighbours, &mean, &cov);
   return FitPlaneFromMoments(mean, cov, plane);
 }
 
@@ -296,6 +308,10 @@ bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
     const int found = map_.KNearest(p_map, options_.max_neighbours, &neighbours_);
     if (found < options_.min_neighbours) return false;
     if (!FitPlane(neighbours_, &knn_plane)) return false;
+    if (knn_plane.sigma2 < options_.line_neighbourhood_ratio * knn_plane.sigma1 &&
+        !FitAcrossLine(p_map, &knn_plane)) {
+      return false;
+    }
   }
   const PlaneFit& plane = *fit;
   const double distance = std::abs(plane.normal.dot(p_map - plane.centroid));
@@ -304,6 +320,41 @@ bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
   association->plane_point = plane.centroid;
   association->plane_normal = plane.normal;
   association->weight = plane.planarity_weight;
+  return true;
+}
+
+bool PlaneAssociator::FitAcrossLine(const Vec3& p_map, PlaneFit* plane) {
+  // The line's direction is the neighbours' largest principal axis; the two axes across it (the
+  // fit's normal and its middle axis) are where another ring of the same surface can lie, one
+  // ring spacing (1–2 m for a VLP-16's floor) away on either side.
+  Vec3 mean;
+  Mat3 covariance;
+  MomentsOf(neighbours_, &mean, &covariance);
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(covariance);
+  if (es.info() != Eigen::Success) return false;
+  const double step = map_.options().voxel_size;
+  const double max_squared = 4.0 * step * step;  // within two map voxels of p_map
+  wide_ = neighbours_;
+  for (int axis = 0; axis < 2; ++axis) {
+    for (const double side : {-1.0, 1.0}) {
+      const Vec3 probe = p_map + side * step * es.eigenvectors().col(axis);
+      map_.KNearest(probe, options_.max_neighbours, &probe_);
+      for (const auto& nb : probe_) {
+        if ((nb.point - p_map).squaredNorm() > max_squared) continue;
+        // The probes' neighbourhoods overlap each other's and the line's: each map point once,
+        // or the overlap would weigh in the fit twice.
+        const bool seen =
+            std::any_of(wide_.begin(), wide_.end(),
+                        [&](const VoxelMap::Neighbour& w) { return w.point == nb.point; });
+        if (!seen) wide_.push_back(nb);
+      }
+    }
+  }
+  PlaneFit wide;
+  if (!FitPlane(wide_, &wide)) return false;
+  if (wide.sigma2 < options_.line_neighbourhood_ratio * wide.sigma1) return false;
+  *plane = wide;
   return true;
 }
 

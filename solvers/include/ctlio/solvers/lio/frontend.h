@@ -65,10 +65,16 @@ class PlaneAssociator {
   bool Associate(const Vec3& q_robot, const Vec3& p_map, PlaneAssociation* association);
 
  private:
+  // The plane of the map points around p_map across the line its k nearest neighbours
+  // (neighbours_) form (LidarFrontendOptions::line_neighbourhood_ratio); false when they are a
+  // line too.
+  bool FitAcrossLine(const Vec3& p_map, PlaneFit* plane);
+
   const VoxelMap& map_;
   LidarFrontendOptions options_;
   bool voxel_planes_;
   std::vector<VoxelMap::Neighbour> neighbours_;
+  std::vector<VoxelMap::Neighbour> wide_, probe_;  // FitAcrossLine's buffers
 };
 
 // A preprocessed sweep as positions in the raw (lidar-frame) sweep, in sweep order.

@@ -45,6 +45,16 @@ struct LidarFrontendOptions {
   // map keeps per voxel (moments updated on insertion, as in iG-LIO / VoxelMap), a hash lookup,
   // with the kNN plane where the voxel holds fewer than min_neighbours points.
   std::string association = "knn";
+  // A kNN neighbourhood whose spread across its main direction is below this fraction of the
+  // spread along it (σ2 < line_neighbourhood_ratio · σ1) is a line, not a plane: a sparse
+  // multi-beam lidar's map seen from one place holds rings (a beam's cut through a surface), 1–2 m
+  // apart on the floor of a VLP-16, so the nearest points of a ring point are that ring, whose
+  // fitted normal is any direction across it and whose planarity weight is ≈ 0. Then the plane is
+  // fitted again to the points around it — the kNN of probes one map voxel away on either side
+  // across the line, within two map voxels of the point — which reach the neighbouring ring of
+  // the same surface; a neighbourhood still a line after that gives no association. 0 = off (the
+  // kNN plane as it is). docs/experiments/covariance.md, "16 beams".
+  double line_neighbourhood_ratio = 0.0;
   // voxel_plane only: a voxel's plane is used when its thickness σ3 (the smallest standard
   // deviation of its points) is at most this, else the kNN plane (a voxel across an edge or a
   // corner is no plane, while the nearest points on one face are).
