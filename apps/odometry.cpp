@@ -117,6 +117,12 @@ DEFINE_bool(strict, false,
             "gaps, IMU samples rejected) is an error naming the defect; for pipelines that must "
             "not guess (docs/user-guide/bad-input.md). Given explicitly it wins over input.strict "
             "of --config");
+DEFINE_int32(accel_reference_scans, 100,
+             "Singer-LIO and imu_input: also run lidar_gyro (no accelerometer) over the first N "
+             "scans as a reference the accelerometer cannot bend, and warn when a relabelling of "
+             "its axes (swapped or flipped columns) explains that trajectory's accelerations "
+             "clearly better than the axes as read (docs/user-guide/bad-input.md); the estimate "
+             "is the same either way. 0 = off");
 DEFINE_bool(progress, true, "Show progress on stderr");
 DEFINE_double(play_rate, 0.0,
               "Give each scan to the odometry at its own time on the wall clock, sped up by this "
@@ -294,6 +300,8 @@ int main(int argc, char** argv) {
     RequireInRange("frontend_threads", FLAGS_frontend_threads, 1, ctlio::apps::kMaxThreads);
     RequireInRange("trajectory_rate", FLAGS_trajectory_rate, 0.0, 1e4, " Hz (0 = off)");
     RequireInRange("play_rate", FLAGS_play_rate, 0.0, 1e6, " (0 = back to back)");
+    RequireInRange("accel_reference_scans", FLAGS_accel_reference_scans, 0, 1'000'000,
+                   " (0 = off)");
     RequireInRange("max_imu_gap_error", FLAGS_max_imu_gap_error, 0.0, 1e6, " s (0 = off)");
     RequireInRange("imu_accel_scale", FLAGS_imu_accel_scale, 1e-6, 1e6,
                    " (9.80665 for an IMU reporting g)");
@@ -366,6 +374,8 @@ int main(int argc, char** argv) {
       options.trajectory_rate_hz = FLAGS_trajectory_rate;
       options.play_rate = FLAGS_play_rate;
       options.replay_adopt_after_s = FLAGS_warmup_replay_adopt_after_s;
+      options.accel_reference_scans = static_cast<size_t>(FLAGS_accel_reference_scans);
+      options.accel_reference_config = base.ForMethod(lio::LioMethod::kLidarGyro);
       lioapp::ProgressReporter progress(std::cerr, lioapp::ProgressReporter::IsTerminal(2));
       progress.SetEventLimit(20, "scans.log has every scan's status and message");
       if (FLAGS_progress) {

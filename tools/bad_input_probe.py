@@ -51,7 +51,7 @@ WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
                  "lidar_gaps", "overlapping_scans")
 WARN_KEYS = ("first_input_warning", "extrinsic_disagreement", "no_ate", "first_lidar_gap",
              "input_defect", "config_warning", "imu_inconsistency", "frame_inconsistency",
-             "degenerate_run")
+             "degenerate_run", "accel_relabelling")
 
 
 # ---------------------------------------------------------------- folder helpers
@@ -367,7 +367,8 @@ def main():
     ap.add_argument("--build", default="build-test")
     ap.add_argument("--out", default="/tmp/ctlio_probe")
     ap.add_argument("--seed", type=int, default=7)
-    ap.add_argument("--only", default="", help="run only classes containing this text")
+    ap.add_argument("--only", default="",
+                    help="run only classes containing this text (several: comma-separated)")
     ap.add_argument("--timeout", type=float, default=180)
     ap.add_argument("--odometry", default="",
                     help="the ctlio_odometry to probe (default: <build>/apps/lio/ctlio_odometry); "
@@ -420,7 +421,7 @@ def main():
         if layout in layouts:
             for cls, name, op in ros2_mutations(rng, clean_bags[layout], cls):
                 cases.append((cls, name, layout, op))
-    cases = [c for c in cases if a.only in c[0]]
+    cases = [c for c in cases if any(o in c[0] for o in a.only.split(","))]
     if a.reader:
         cases = [c for c in cases if c[2] not in ("config", "flags")]
     if a.sample and a.sample < len(cases):

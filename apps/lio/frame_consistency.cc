@@ -73,6 +73,30 @@ std::string SignedPermutation(const Mat3& M) {
   return out + ")";
 }
 
+// Calls fn(P) for each of the 48 signed permutation matrices.
+template <class Fn>
+void ForEachSignedPermutation(Fn&& fn) {
+  int perm[3] = {0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      Mat3 P = Mat3::Zero();
+      for (int i = 0; i < 3; ++i) P(i, perm[i]) = (signs >> i) & 1 ? -1.0 : 1.0;
+      fn(P);
+    }
+  } while (std::next_permutation(perm, perm + 3));
+}
+
+// Residual sum of squares of the specific-force fit with M fixed and g refitted:
+// g = N_gg⁻¹(v_g − N_gM·vec(M)).
+double FixedMapSquares(const Eigen::Matrix<double, 12, 12>& N,
+                       const Eigen::Matrix<double, 12, 1>& v, double s, const Mat3& M) {
+  Eigen::Matrix<double, 12, 1> x;
+  x.head<9>() = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(M.data());
+  x.tail<3>() = N.bottomRightCorner<3, 3>().ldlt().solve(v.tail<3>() -
+                                                         N.bottomLeftCorner<3, 9>() * x.head<9>());
+  return std::max(0.0, s - 2.0 * x.dot(v) + x.dot(N * x));
+}
+
 }  // namespace
 
 FrameConsistencyCheck::FrameConsistencyCheck(const SE3& T_robot_imu, int imu,
@@ -211,18 +235,23 @@ FrameConsistency FrameConsistencyCheck::Result() const {
       }
     }
     const double ss_free = std::max(0.0, s_ - 2.0 * x.dot(v_) + x.dot(N_ * x));
-    // Identity fit: vec(M) = vec(I), g = N_gg⁻¹(v_g − N_gM·vec(I)).
-    Eigen::Matrix<double, 12, 1> xi = Eigen::Matrix<double, 12, 1>::Zero();
-    xi[0] = xi[4] = xi[8] = 1.0;
-    xi.tail<3>() = N_.bottomRightCorner<3, 3>().ldlt().solve(
-        v_.tail<3>() - N_.bottomLeftCorner<3, 9>() * xi.head<9>());
-    const double ss_id = std::max(0.0, s_ - 2.0 * xi.dot(v_) + xi.dot(N_ * xi));
+    const double ss_id = FixedMapSquares(N_, v_, s_, Mat3::Identity());
     r.identity_rms = std::sqrt(ss_id / (3.0 * windows_));
     r.free_rms = std::sqrt(ss_free / (3.0 * windows_));
     r.explained = ss_id > 0.0 ? (ss_id - ss_free) / ss_id : 0.0;
     r.map = Eigen::Map<const Mat3>(x.data());
     r.map_deviation = (r.map - Mat3::Identity()).norm();
     r.map_reading = SignedPermutation(r.map);
+    double ss_best = -1.0;
+    ForEachSignedPermutation([&](const Mat3& P) {
+      if (P.isIdentity()) return;
+      const double ss = FixedMapSquares(N_, v_, s_, P);
+      if (ss_best < 0.0 || ss < ss_best) {
+        ss_best = ss;
+        r.best_relabelling = SignedPermutation(P);
+      }
+    });
+    r.best_relabelling_rms = std::sqrt(ss_best / (3.0 * windows_));
   }
   if (spans_ >= options_.min_windows) {
     // δ with the bias eliminated (Schur complement), solved along the excited axes only.
@@ -285,7 +314,9 @@ void WriteFrameConsistency(const FrameConsistency& r, std::ostream& out) {
   if (r.windows == 0 && r.rotation_spans == 0) return;
   out << "frame_windows " << r.windows << "\nframe_map_explained " << r.explained
       << "\nframe_identity_rms " << r.identity_rms << "\nframe_free_rms " << r.free_rms
-      << "\nframe_map_deviation " << r.map_deviation << "\nframe_map";
+      << "\nframe_map_deviation " << r.map_deviation << "\nframe_best_relabelling_rms "
+      << r.best_relabelling_rms << "\nframe_best_relabelling \"" << r.best_relabelling
+      << "\"\nframe_map";
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) out << ' ' << r.map(i, j);
   }

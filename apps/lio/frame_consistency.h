@@ -62,6 +62,10 @@ struct FrameConsistency {
   Mat3 map = Mat3::Identity();  // the fitted M
   double map_deviation = 0.0;   // |M − I|_F
   std::string map_reading;      // "(-x, -y, -z)": M's nearest signed permutation, or "" if none
+  // The signed permutation P ≠ I (one of the 47 other labellings of the accelerometer's axes, no
+  // free parameter, g refitted) that explains the positions best, and its residual RMS.
+  std::string best_relabelling;
+  double best_relabelling_rms = 0.0;
   int rotation_spans = 0;
   Vec3 rotation_error = Vec3::Zero();  // δ [rad], along the excited directions only
   int excited_axes = 0;

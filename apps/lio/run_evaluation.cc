@@ -73,6 +73,17 @@ void WriteRunEvaluation(const RunSummary& run,
     ev << "imu_inconsistency \"" << run.imu_inconsistency << "\"\n";
   }
   WriteFrameConsistency(run.frames, ev);
+  if (run.accel_reference_scans > 0 && run.accel_reference.windows > 0) {
+    const FrameConsistency& a = run.accel_reference;
+    ev << "accel_reference_scans " << run.accel_reference_scans << "\naccel_reference_windows "
+       << a.windows << "\naccel_reference_identity_rms " << a.identity_rms
+       << "\naccel_reference_free_rms " << a.free_rms << "\naccel_reference_best_relabelling \""
+       << a.best_relabelling << "\"\naccel_reference_best_relabelling_rms "
+       << a.best_relabelling_rms << "\n";
+  }
+  if (!run.accel_relabelling.empty()) {
+    ev << "accel_relabelling \"" << run.accel_relabelling << "\"\n";
+  }
   if (run.overlapping_scans > 0) {
     ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
        << run.first_overlapping_scan << "\"\n";
@@ -244,6 +255,10 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     }
     if (!r.frames.warning.empty()) {
       std::printf("  %-10s WARNING frames: %s\n", r.method.c_str(), r.frames.warning.c_str());
+    }
+    if (!r.accel_relabelling.empty()) {
+      std::printf("  %-10s WARNING accelerometer: %s\n", r.method.c_str(),
+                  r.accel_relabelling.c_str());
     }
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),

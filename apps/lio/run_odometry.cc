@@ -16,6 +16,7 @@
 #include <thread>
 #include <utility>
 
+#include "accel_reference.h"
 #include "ctlio/eval/trajectory_metrics.h"
 #include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/io/checked_output.h"
@@ -294,10 +295,21 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   // The IMU's frame against the lidar trajectory's (frame_consistency.h); lidar_only uses no IMU.
   FrameConsistencyCheck frames(config.ImuPose(0));
   const bool check_frames = config.method != lio::LioMethod::kLidarOnly;
+  // lidar_gyro's own poses already leave the accelerometer out: its frame fit is the reference.
+  std::optional<AccelReference> reference;
+  if (options.accel_reference_scans > 0 && options.accel_reference_config &&
+      (config.method == lio::LioMethod::kSingerLio || config.method == lio::LioMethod::kImuInput)) {
+    lio::OdometryConfig c = *options.accel_reference_config;
+    c.T_imu_lidar = config.T_imu_lidar;
+    c.gravity = config.gravity;
+    c.imus = config.imus;
+    reference.emplace(c, options.accel_reference_scans);
+  }
   while ((options.max_scans == 0 || done < options.max_scans) && source.Next(&frame)) {
     for (const io::ImuSample& x : frame.imu) {
       odometry->AddImu(x);
       if (check_frames) frames.AddImu(x);
+      if (reference) reference->AddImu(x);
     }
     if (have_previous && frame.end_ns <= previous_end) {
       ++run.scans_skipped;
@@ -329,7 +341,9 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
                                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                         std::chrono::duration<double>(seconds)));
     }
-    const lio::ScanResult r = odometry->AddScan(TakeLidarScan(&frame));
+    const lio::LidarScan scan = TakeLidarScan(&frame);
+    const lio::ScanResult r = odometry->AddScan(scan);
+    if (reference) reference->AddScan(scan);
     if (r.status == lio::ScanStatus::kOk && check_frames) {
       frames.AddPose(r.t_ns, r.T_mr);
     } else {
@@ -459,6 +473,18 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.frames.warning;
       if (io::WarningLimiter::Strict()) {
         throw std::runtime_error(source.Name() + ": " + run.method + ": " + run.frames.warning +
+                                 " (--strict / input.strict: an inconsistent input is an error)");
+      }
+    }
+  }
+  if (reference || config.method == lio::LioMethod::kLidarGyro) {
+    run.accel_reference = reference ? reference->Result() : run.frames;
+    run.accel_reference_scans = reference ? reference->scans() : static_cast<int>(done);
+    run.accel_relabelling = RelabellingWarning(run.accel_reference, run.accel_reference_scans);
+    if (!run.accel_relabelling.empty()) {
+      LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.accel_relabelling;
+      if (io::WarningLimiter::Strict()) {
+        throw std::runtime_error(source.Name() + ": " + run.method + ": " + run.accel_relabelling +
                                  " (--strict / input.strict: an inconsistent input is an error)");
       }
     }

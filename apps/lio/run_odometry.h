@@ -48,6 +48,12 @@ struct RunOptions {
   // A replay adopted at the end of the input (replay_adopt_after_s past it) hands over nothing:
   // the map stays the live one.
   std::function<void(const lio::ScanResult&, const std::vector<Vec3>&)> map_points;
+  // > 0 (and a method that uses the accelerometer): also run the lidar + gyro reference of
+  // accel_reference.h over the first this many scans, with this config (the lidar_gyro one of the
+  // run's file; extrinsic, gravity and IMUs are taken from the run's), and judge the accelerometer
+  // against it (RunSummary::accel_relabelling). 0: not run (the estimate is the same either way).
+  size_t accel_reference_scans = 0;
+  std::optional<lio::OdometryConfig> accel_reference_config;
 };
 
 struct RunSummary {
@@ -155,6 +161,11 @@ struct RunSummary {
   // Lidar–IMU frame consistency (frame_consistency.h): the fits and the warning (empty when
   // consistent or not judged; not run for lidar_only); not a failure.
   FrameConsistency frames;
+  // The accelerometer against a lidar + gyro reference (accel_reference.h): its frame fit, the
+  // scans it ran over (0: not run) and the warning (empty when nothing stands out).
+  FrameConsistency accel_reference;
+  int accel_reference_scans = 0;
+  std::string accel_relabelling;
   // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`
   // (the estimate left the room of any sensible error), or the lidar registered no scan.
   bool failure = false;

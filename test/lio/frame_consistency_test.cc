@@ -99,6 +99,17 @@ TEST(FrameConsistency, AFlippedOrSwappedAccelerometerIsNamed) {
   EXPECT_GT(r.identity_rms, 1.0);
   EXPECT_EQ(r.map_reading, "(+z, +y, +x)");
   EXPECT_NE(r.warning.find("reading (+z, +y, +x)"), std::string::npos) << r.warning;
+  // Among the 47 relabellings other than the axes as read, the swap itself explains the positions
+  // as well as the clean stream's own axes do (accel_reference.h judges by that).
+  EXPECT_EQ(r.best_relabelling, "(+z, +y, +x)");
+  EXPECT_LT(r.best_relabelling_rms, 0.02);
+}
+
+TEST(FrameConsistency, TheBestRelabellingOfACleanStreamFitsFarWorseThanItsAxes) {
+  const lioapp::FrameConsistency r = Check(Motion{}, [](const Vec3& f) { return f; });
+  EXPECT_FALSE(r.best_relabelling.empty());
+  EXPECT_NE(r.best_relabelling, "(+x, +y, +z)");
+  EXPECT_GT(r.best_relabelling_rms, 20.0 * r.identity_rms);
 }
 
 TEST(FrameConsistency, ARotatedExtrinsicIsFoundWhereTheRotationExcitesIt) {

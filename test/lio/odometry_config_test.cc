@@ -135,6 +135,20 @@ TEST(OdometryConfig, BadValuesAreErrors) {
                  std::runtime_error)
         << k;
   }
+  // A gravity window of 1e30 s overflowed its nanoseconds (signed overflow, found by the bad-input
+  // probe under UBSan): an error naming the key and the range.
+  for (const char* d : {"1e30", "3601", ".inf"}) {
+    try {
+      LoadOdometryConfig(
+          WriteTemp("g.yaml", std::string("init:\n  gravity_duration: ") + d + "\n"));
+      ADD_FAILURE() << d << ": no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("init.gravity_duration must be in [0, 3600] s"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(LoadOdometryConfig(WriteTemp("g.yaml", "init:\n  gravity_duration: 3600\n")));
 }
 
 // NaN or Inf anywhere in an extrinsic is an error naming the file, the line and the element (NaN

@@ -38,7 +38,11 @@ void OdometryConfig::Validate() const {
   require(input_midpoint || (input_interpolation == "linear" && input_substeps == 1),
           "imu.input_interpolation cubic and imu.input_substeps > 1 need imu.input_midpoint: true "
           "(a held sample has no value between samples to read)");
-  require(gravity_init_duration >= 0 && gravity_init_max_std > 0, "bad init parameters");
+  // The window becomes nanoseconds before the first scan end (gravity_alignment.cc): 1e30 s
+  // overflowed int64 there (UBSan, the bad-input probe), and no real start rests for an hour.
+  require(gravity_init_duration >= 0 && gravity_init_duration <= 3600,
+          "init.gravity_duration must be in [0, 3600] s");
+  require(gravity_init_max_std > 0, "init.gravity_max_std must be positive");
   require(min_associations >= 0, "init.min_associations must be >= 0");
   require(max_imu_gap > 0, "init.max_imu_gap must be positive");
   require(gap_velocity_walk > 0, "imu.gap_velocity_walk must be positive");
