@@ -273,6 +273,34 @@ TEST(CalibrationOutput, TheOverlayKeepsAnOffsetFlaggedOnAFifthOfTheScans) {
   EXPECT_TRUE(loose->kept_at_start.empty());
 }
 
+// data/calibration.yaml's drift check (3σ, the code's default 2.5σ) for a 60 s calibration
+// sequence: over its second half an informed coordinate moved up to 2.6σ (tuning walking/100,
+// the baseline's φ_z), where the slow regime's δ moved 3.4σ (slow/100, Singer-LIO, 12 ms off at
+// σ 0.31 ms, below 0.5 ms) and every other drifting coordinate more. δ here: σ 0.2 ms, never
+// flagged, moving linearly over the second half by 2.6σ or 3.4σ.
+TEST(CalibrationOutput, TheOverlaysDriftCheckSeparatesASixtySecondRunsMovements) {
+  Vec6 sigma;
+  sigma << 0.005, 0.005, 0.005, 0.05 * kDeg, 0.05 * kDeg, 0.05 * kDeg;
+  const auto moving = [&](double sigmas) {
+    RunSummary run =
+        ConstructedRun(101, {0, 0, 0, 0, 0, 0, 0}, 0.0, Start(), Estimate(), 2e-4, sigma);
+    for (int k = 50; k <= 100; ++k) {
+      run.scans[static_cast<size_t>(k)].calibration.time_offset_s[0] +=
+          (k - 50) / 50.0 * sigmas * 2e-4;
+    }
+    return run;
+  };
+  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const lio::CalibrationOptions overlay =
+      lio::LoadOdometryConfig(data + "sim_lio.yaml," + data + "calibration.yaml").calibration;
+  EXPECT_TRUE(RecommendCalibration(moving(2.6), overlay)->kept_at_start.empty());
+  EXPECT_EQ(RecommendCalibration(moving(3.4), overlay)->kept_at_start,
+            std::vector<std::string>{"time_offset_0"});
+  // The code's default keeps the informed one too.
+  EXPECT_EQ(RecommendCalibration(moving(2.6), lio::CalibrationOptions())->kept_at_start,
+            std::vector<std::string>{"time_offset_0"});
+}
+
 TEST(CalibrationOutput, NoSigmaKeepsTheStart) {
   // A scan without a covariance reports σ 0 (the extrinsic) or NaN: not a certain estimate.
   const RunSummary run =
