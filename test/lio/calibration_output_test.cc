@@ -242,6 +242,65 @@ TEST(CalibrationOutput, AnEstimateThatDriftsOverTheSecondHalfKeepsTheStart) {
   }
 }
 
+// data/calibration.yaml's share (0.1, the code's default 0.5): tuning run slow/100 (translation
+// only) ended with δ 15.3 ms off at σ 0.52 ms (just above 0.5 ms; 0.017 of the prior's), flagged
+// after 19% of the scans and converged (moved 1σ over the second half), so only the share tells
+// it from an informed coordinate; every informed coordinate the ratio decides (walking's
+// rotation, σ 0.10-0.23°; a lever-arm axis at 1.0-1.15 cm) was flagged after 0% of the scans on
+// the tuning, reported and unseen runs (docs/experiments/calibration.md, "The write rule").
+TEST(CalibrationOutput, TheOverlayKeepsAnOffsetFlaggedOnAFifthOfTheScans) {
+  Vec6 sigma;  // ρ and φ_x, φ_z below the thresholds; φ_y walking's 0.17° (0.034 of the prior's)
+  sigma << 0.005, 0.005, 0.005, 0.05 * kDeg, 0.17 * kDeg, 0.05 * kDeg;
+  const RunSummary run =
+      ConstructedRun(101, {20, 0, 0, 0, 0, 0, 0}, 0.0, Start(), Estimate(), 5.2e-4, sigma);
+  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const lio::OdometryConfig overlay =
+      lio::LoadOdometryConfig(data + "sim_lio.yaml," + data + "calibration.yaml");
+  for (const lio::LioMethod m : {lio::LioMethod::kSingerLio, lio::LioMethod::kImuInput}) {
+    const auto r = RecommendCalibration(run, overlay.ForMethod(m).calibration);
+    ASSERT_TRUE(r.has_value());
+    EXPECT_NEAR(r->coordinates[0].unobservable_fraction, 0.19, 1e-12);
+    EXPECT_EQ(r->kept_at_start, std::vector<std::string>{"time_offset_0"});
+    EXPECT_EQ(r->time_offset_s[0], 0.0);
+    EXPECT_NE(r->coordinates[0].reason.find("flagged unobservable after more than 10%"),
+              std::string::npos)
+        << r->coordinates[0].reason;
+    EXPECT_TRUE(r->coordinates[5].estimate_written);  // φ_y: informed, never flagged
+  }
+  // The code's default share writes that offset.
+  const auto loose = RecommendCalibration(run, lio::CalibrationOptions());
+  ASSERT_TRUE(loose.has_value());
+  EXPECT_TRUE(loose->kept_at_start.empty());
+}
+
+// data/calibration.yaml's drift check (3σ, the code's default 2.5σ) for a 60 s calibration
+// sequence: over its second half an informed coordinate moved up to 2.6σ (tuning walking/100,
+// the baseline's φ_z), where the slow regime's δ moved 3.4σ (slow/100, Singer-LIO, 12 ms off at
+// σ 0.31 ms, below 0.5 ms) and every other drifting coordinate more. δ here: σ 0.2 ms, never
+// flagged, moving linearly over the second half by 2.6σ or 3.4σ.
+TEST(CalibrationOutput, TheOverlaysDriftCheckSeparatesASixtySecondRunsMovements) {
+  Vec6 sigma;
+  sigma << 0.005, 0.005, 0.005, 0.05 * kDeg, 0.05 * kDeg, 0.05 * kDeg;
+  const auto moving = [&](double sigmas) {
+    RunSummary run =
+        ConstructedRun(101, {0, 0, 0, 0, 0, 0, 0}, 0.0, Start(), Estimate(), 2e-4, sigma);
+    for (int k = 50; k <= 100; ++k) {
+      run.scans[static_cast<size_t>(k)].calibration.time_offset_s[0] +=
+          (k - 50) / 50.0 * sigmas * 2e-4;
+    }
+    return run;
+  };
+  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const lio::CalibrationOptions overlay =
+      lio::LoadOdometryConfig(data + "sim_lio.yaml," + data + "calibration.yaml").calibration;
+  EXPECT_TRUE(RecommendCalibration(moving(2.6), overlay)->kept_at_start.empty());
+  EXPECT_EQ(RecommendCalibration(moving(3.4), overlay)->kept_at_start,
+            std::vector<std::string>{"time_offset_0"});
+  // The code's default keeps the informed one too.
+  EXPECT_EQ(RecommendCalibration(moving(2.6), lio::CalibrationOptions())->kept_at_start,
+            std::vector<std::string>{"time_offset_0"});
+}
+
 TEST(CalibrationOutput, NoSigmaKeepsTheStart) {
   // A scan without a covariance reports σ 0 (the extrinsic) or NaN: not a certain estimate.
   const RunSummary run =
