@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "common/sim_gp_state.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/imu/imu_residual.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
@@ -18,14 +19,7 @@
 namespace ctlio::lio {
 namespace {
 
-// The GP state of the simulated body at t (map frame = world frame, SPEC §1: T_rm, ϖ = −twist).
-gp::KnotState TrueState(const sim::LidarInertialSim& sim, double t) {
-  gp::KnotState x;
-  x.pose = sim.WorldFromImu(t).Inverse();
-  x.velocity = -sim.BodyTwist(t);
-  x.acceleration = -sim.BodyTwistRate(t);
-  return x;
-}
+using ctlio::testing::TrueState;
 
 struct Fit {
   double interpolated = 0.0;  // RMS |e_a| with x(τ) interpolated from the true knots [m/s²]

@@ -12,6 +12,7 @@
 
 #include <vector>
 
+#include "common/sim_gp_state.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
@@ -19,14 +20,7 @@
 namespace ctlio::lio {
 namespace {
 
-// The GP state of the simulated body at t (map frame = world frame, SPEC §1: T_rm, ϖ = −twist).
-gp::KnotState TrueState(const sim::LidarInertialSim& sim, double t) {
-  gp::KnotState x;
-  x.pose = sim.WorldFromImu(t).Inverse();
-  x.velocity = -sim.BodyTwist(t);
-  x.acceleration = -sim.BodyTwistRate(t);
-  return x;
-}
+using ctlio::testing::TrueState;
 
 // The IMU's readings at 200 Hz in (t0, t1], plus the bias.
 std::vector<TimedImuSample> Samples(const sim::LidarInertialSim& sim, double t0, double t1,

@@ -38,15 +38,6 @@ void FurnishPark(Scene& s, const Path& path, const ParkBounds& park, uint64_t se
     for (const Mover& m : lanes) d = std::min(d, DistanceToSegment(x, y, m.a, m.b) - 0.5);
     return d;
   };
-  auto style = [&]() {
-    content::FacadeStyle st;
-    st.window_width = U(0.9, 1.5);
-    st.window_height = U(1.4, 2.0);
-    st.pier = U(0.9, 2.2);
-    st.recess = U(0.2, 0.35);
-    st.glass_fraction = U(0.2, 0.6);
-    return st;
-  };
 
   // The rim on the south, east and north sides, in runs of 12–24 m: a stone wall 2.8–4.5 m high
   // just outside the lawn with buttresses every 10–16 m, and behind a quarter of the runs a
@@ -73,7 +64,7 @@ void FurnishPark(Scene& s, const Path& path, const ParkBounds& park, uint64_t se
         const Vec3 p = at(u, wb), q = at(u + len, wb + depth);
         const int storeys = 2 + int(U(0, 2));
         content::AddBuilding(s, rng, p.cwiseMin(q), p.cwiseMax(q), storeys, 3.5 * U(0.95, 1.05),
-                             side.facade, style());
+                             side.facade, content::CollegeFacadeStyle(rng));
       }
       u += len;
     }

@@ -53,6 +53,16 @@ void AddHedge(Scene& s, const Vec3& a, const Vec3& b, double height, double free
                      free_path, true});
 }
 
+FacadeStyle CollegeFacadeStyle(std::mt19937_64& rng) {
+  FacadeStyle st;
+  st.window_width = Uniform(rng, 0.9, 1.5);
+  st.window_height = Uniform(rng, 1.4, 2.0);
+  st.pier = Uniform(rng, 0.9, 2.2);
+  st.recess = Uniform(rng, 0.2, 0.35);
+  st.glass_fraction = Uniform(rng, 0.2, 0.6);
+  return st;
+}
+
 void AddFacade(Scene& s, std::mt19937_64& rng, const Facade& F, double L, int storeys,
                double storey, const FacadeStyle& st) {
   const double r = st.recess, top = storeys * storey;

@@ -39,6 +39,9 @@ struct FacadeStyle {
   double balcony_probability = 0.1;  // per upper window
   double door_probability = 0.15;    // per ground-floor window
 };
+// The quad's stone ranges and the park's buildings behind its rim (one style, drawn per building):
+// windows 0.9–1.5 × 1.4–2.0 m between 0.9–2.2 m piers, recessed 0.2–0.35 m, 20–60 % glass.
+FacadeStyle CollegeFacadeStyle(std::mt19937_64& rng);
 // One wall of windows in its own frame p(u, w, z) = a + u·e + w·n (u ∈ [0, L] along the wall,
 // z ∈ [0, storeys·storey] above a, w outwards): piers and bands fill w ∈ [0, recess], the openings
 // show what lies at w < 0 (a building's body; an office's outer wall) or glass.

@@ -38,15 +38,6 @@ World BuildQuadWorld(const QuadParams& p, uint64_t seed) {
 
   // The four ranges, each a row of buildings of random length, height and windows; only the
   // façades that can be seen get windows (the quad side; the east range's park side).
-  auto style = [&]() {
-    content::FacadeStyle st;
-    st.window_width = U(0.9, 1.5);
-    st.window_height = U(1.4, 2.0);
-    st.pier = U(0.9, 2.2);
-    st.recess = U(0.2, 0.35);
-    st.glass_fraction = U(0.2, 0.6);
-    return st;
-  };
   // A range along x from xa to xb (y ∈ [y0, y1]) or along y (x ∈ [y0, y1]), split into buildings.
   auto range = [&](bool along_x, double a0, double a1, double b0, double b1, int facades) {
     for (double a = a0; a < a1 - 1.0;) {
@@ -55,7 +46,8 @@ World BuildQuadWorld(const QuadParams& p, uint64_t seed) {
       const int storeys = 3 + int(U(0, 2));
       const Vec3 lo = along_x ? Vec3(a, b0, 0) : Vec3(b0, a, 0);
       const Vec3 hi = along_x ? Vec3(a + len, b1, 0) : Vec3(b1, a + len, 0);
-      content::AddBuilding(s, rng, lo, hi, storeys, p.storey * U(0.95, 1.05), facades, style());
+      content::AddBuilding(s, rng, lo, hi, storeys, p.storey * U(0.95, 1.05), facades,
+                           content::CollegeFacadeStyle(rng));
       a += len;
     }
   };
