@@ -51,7 +51,7 @@ WARN_COUNTERS = ("failed_scans", "imu_gap_scans", "imu_samples_rejected",
                  "lidar_gaps", "overlapping_scans")
 WARN_KEYS = ("first_input_warning", "extrinsic_disagreement", "no_ate", "first_lidar_gap",
              "input_defect", "config_warning", "imu_inconsistency", "frame_inconsistency",
-             "degenerate_run", "accel_relabelling")
+             "degenerate_run", "accel_relabelling", "reference_disagreement")
 
 
 # The mutations live in their own module beside this one.

@@ -1,7 +1,9 @@
 #include "lio/accel_reference.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <map>
 
 namespace ctlio::lioapp {
 
@@ -24,6 +26,23 @@ std::string RelabellingWarning(const FrameConsistency& reference, int scans,
                 reference.identity_rms,
                 reference.identity_rms / std::max(reference.best_relabelling_rms, 1e-12),
                 options.min_gain, reference.free_rms);
+  return text;
+}
+
+std::string DisagreementWarning(const ReferenceDisagreement& d, int scans,
+                                const DisagreementOptions& options) {
+  if (options.max_fraction <= 0.0 || d.pairs < options.min_pairs || d.path_m < options.min_path_m ||
+      d.rms_m <= options.max_fraction * d.path_m) {
+    return "";
+  }
+  char text[900];
+  std::snprintf(text, sizeof(text),
+                "the estimate departs from a lidar + gyro reference (no accelerometer in it) by "
+                "%.3g m RMS (max %.3g m) over the first %d scans (%.1f %% of its %.3g m path; "
+                "threshold %.1f %%): an IMU defect (accelerometer axes, signs or units, the "
+                "extrinsic) or a scene the lidar does not constrain",
+                d.rms_m, d.max_m, scans, 100.0 * d.rms_m / d.path_m, d.path_m,
+                100.0 * options.max_fraction);
   return text;
 }
 
@@ -51,16 +70,51 @@ void AccelReference::AddImu(const lio::ImuSample& sample) {
 }
 
 void AccelReference::AddScan(const lio::LidarScan& scan) {
-  if (!Active()) return;
+  took_last_scan_ = Active();
+  if (!took_last_scan_) return;
   ++scans_;
   const lio::ScanResult r = odometry_->AddScan(scan);
   if (r.status == lio::ScanStatus::kOk) {
     frames_.AddPose(r.t_ns, r.T_mr);
+    reference_poses_.emplace_back(r.t_ns, r.T_mr);
   } else {
     frames_.Break();
   }
   // The estimator's memory is not needed past the stretch.
   if (!Active()) odometry_.reset();
+}
+
+void AccelReference::AddEstimate(int64_t t_ns, const SE3& T_mr) {
+  if (!took_last_scan_ || !T_mr.translation().allFinite()) return;
+  estimate_poses_.emplace_back(t_ns, T_mr);
+}
+
+ReferenceDisagreement AccelReference::Disagreement() const {
+  ReferenceDisagreement d;
+  std::map<int64_t, const SE3*> estimate;
+  for (const auto& [t, T] : estimate_poses_) estimate[t] = &T;
+  const SE3* ref0 = nullptr;
+  const SE3* est0 = nullptr;
+  Vec3 previous = Vec3::Zero();
+  double sum_sq = 0.0;
+  for (const auto& [t, T] : reference_poses_) {
+    const auto it = estimate.find(t);
+    if (it == estimate.end() || !T.translation().allFinite()) continue;
+    if (ref0 == nullptr) {
+      ref0 = &T;
+      est0 = it->second;
+    }
+    const Vec3 p_ref = (ref0->Inverse() * T).translation();
+    const Vec3 p_est = (est0->Inverse() * *it->second).translation();
+    const double e = (p_est - p_ref).norm();
+    if (d.pairs > 0) d.path_m += (p_ref - previous).norm();
+    previous = p_ref;
+    sum_sq += e * e;
+    d.max_m = std::max(d.max_m, e);
+    ++d.pairs;
+  }
+  if (d.pairs > 0) d.rms_m = std::sqrt(sum_sq / d.pairs);
+  return d;
 }
 
 }  // namespace ctlio::lioapp

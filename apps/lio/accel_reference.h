@@ -15,8 +15,11 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -39,6 +42,33 @@ struct RelabellingOptions {
 std::string RelabellingWarning(const FrameConsistency& reference, int scans,
                                const RelabellingOptions& options = {});
 
+// The method's positions against the reference's over the scans both registered, each trajectory
+// taken relative to its first common pose (T0⁻¹·T, so the map frames need not agree):
+//   rms_m = sqrt(mean |p_method − p_reference|²),  max_m = max |…|,
+//   path_m = Σ |p_reference(k) − p_reference(k−1)|  (the reference's distance travelled).
+// A general statistic: any IMU defect that bends the fused trajectory away from what the lidar and
+// the gyro alone say (axes, units, extrinsic) shows, whether or not a relabelling explains it.
+struct ReferenceDisagreement {
+  int pairs = 0;
+  double rms_m = 0.0;
+  double max_m = 0.0;
+  double path_m = 0.0;
+};
+
+struct DisagreementOptions {
+  // rms_m / path_m above this warns; 0 = never. Measured over 80-scan references (8 s;
+  // docs/user-guide/bad-input.md, "Departure from the reference"): 66 clean runs 0.09-7.2 % (the
+  // 7.2 % a baseline run whose estimate was itself 3.5 m off; 3.58 % at most with a good one), the
+  // baseline following a flipped accelerometer 24-194 % (Mid-360 quad fast, the box).
+  double max_fraction = 0.15;
+  double min_path_m = 1.0;  // below it the fraction is noise: not judged
+  int min_pairs = 20;
+};
+
+// "the estimate departs from a lidar + gyro reference by …" or empty when within the threshold.
+std::string DisagreementWarning(const ReferenceDisagreement& d, int scans,
+                                const DisagreementOptions& options = {});
+
 class AccelReference {
  public:
   // `config`: the run's config (extrinsic, gravity and IMUs as the run uses them); the reference
@@ -48,14 +78,19 @@ class AccelReference {
   bool Active() const { return scans_ < max_scans_; }
   void AddImu(const lio::ImuSample& sample);
   void AddScan(const lio::LidarScan& scan);
+  // The method's pose for the scan just handed to AddScan (only read, never fed back).
+  void AddEstimate(int64_t t_ns, const SE3& T_mr);
   int scans() const { return static_cast<int>(scans_); }
   FrameConsistency Result() const { return frames_.Result(); }
+  ReferenceDisagreement Disagreement() const;
 
  private:
   std::unique_ptr<lio::LioOdometry> odometry_;
   FrameConsistencyCheck frames_;
   size_t max_scans_;
   size_t scans_ = 0;
+  bool took_last_scan_ = false;
+  std::vector<std::pair<int64_t, SE3>> reference_poses_, estimate_poses_;
 };
 
 }  // namespace ctlio::lioapp

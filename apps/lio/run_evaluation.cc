@@ -84,6 +84,14 @@ void WriteRunEvaluation(const RunSummary& run,
   if (!run.accel_relabelling.empty()) {
     ev << "accel_relabelling \"" << run.accel_relabelling << "\"\n";
   }
+  if (run.reference_pairs > 0) {
+    ev << "reference_disagreement_rms_m " << run.reference_rms_m
+       << "\nreference_disagreement_max_m " << run.reference_max_m << "\nreference_path_m "
+       << run.reference_path_m << "\n";
+  }
+  if (!run.reference_disagreement.empty()) {
+    ev << "reference_disagreement \"" << run.reference_disagreement << "\"\n";
+  }
   if (run.overlapping_scans > 0) {
     ev << "overlapping_scans " << run.overlapping_scans << "\nfirst_overlapping_scan \""
        << run.first_overlapping_scan << "\"\n";
@@ -259,6 +267,10 @@ void PrintRunTables(const std::vector<RunSummary>& runs) {
     if (!r.accel_relabelling.empty()) {
       std::printf("  %-10s WARNING accelerometer: %s\n", r.method.c_str(),
                   r.accel_relabelling.c_str());
+    }
+    if (!r.reference_disagreement.empty()) {
+      std::printf("  %-10s WARNING reference: %s\n", r.method.c_str(),
+                  r.reference_disagreement.c_str());
     }
     if (!r.extrinsic_disagreement.empty()) {
       std::printf("  %-10s WARNING extrinsic: %s\n", r.method.c_str(),

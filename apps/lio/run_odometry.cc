@@ -343,7 +343,10 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
     const lio::LidarScan scan = TakeLidarScan(&frame);
     const lio::ScanResult r = odometry->AddScan(scan);
-    if (reference) reference->AddScan(scan);
+    if (reference) {
+      reference->AddScan(scan);
+      if (r.status == lio::ScanStatus::kOk) reference->AddEstimate(r.t_ns, r.T_mr);
+    }
     if (r.status == lio::ScanStatus::kOk && check_frames) {
       frames.AddPose(r.t_ns, r.T_mr);
     } else {
@@ -487,6 +490,17 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
         throw std::runtime_error(source.Name() + ": " + run.method + ": " + run.accel_relabelling +
                                  " (--strict / input.strict: an inconsistent input is an error)");
       }
+    }
+  }
+  if (reference) {
+    const ReferenceDisagreement d = reference->Disagreement();
+    run.reference_rms_m = d.rms_m;
+    run.reference_max_m = d.max_m;
+    run.reference_path_m = d.path_m;
+    run.reference_pairs = d.pairs;
+    run.reference_disagreement = DisagreementWarning(d, run.accel_reference_scans);
+    if (!run.reference_disagreement.empty()) {
+      LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.reference_disagreement;
     }
   }
   run.failure = run.failed > 0 || run.constant_imu_scans > 0 ||

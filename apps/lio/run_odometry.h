@@ -166,6 +166,11 @@ struct RunSummary {
   FrameConsistency accel_reference;
   int accel_reference_scans = 0;
   std::string accel_relabelling;
+  // The method's positions against that reference's (accel_reference.h: RMS, max, path) and the
+  // warning when they part by more than the threshold (empty otherwise); not a failure.
+  double reference_rms_m = 0.0, reference_max_m = 0.0, reference_path_m = 0.0;
+  int reference_pairs = 0;
+  std::string reference_disagreement;
   // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`
   // (the estimate left the room of any sensible error), or the lidar registered no scan.
   bool failure = false;

@@ -7,7 +7,11 @@
 //     warned about and its estimate is the same with the reference as without, bit for bit; an
 //     x↔z-swapped accelerometer is warned about and read back as (+z, +y, +x) — for the baseline
 //     also where the frame check of its own trajectory (frame_consistency.h) stays below its
-//     threshold (the fused trajectory follows the swapped accelerometer part of the way).
+//     threshold (the fused trajectory follows the swapped accelerometer part of the way);
+//   * the disagreement with the reference: the rule on given values (above the threshold fraction
+//     of the path warns, below it or over a short path does not), and end to end: the clean runs
+//     stay below it, a sign-flipped accelerometer with the baseline (the kind of run that no
+//     relabelling in a poor reference explains) is warned.
 #include "lio/accel_reference.h"
 
 #include <gtest/gtest.h>
@@ -76,8 +80,13 @@ TEST(AccelReference, ASwappedAccelerometerIsWarnedCleanIsNotAndTheEstimateIsUnch
           ref.best_relabelling.c_str(), ref.best_relabelling_rms, ref.free_rms,
           run.frames.identity_rms, run.ate ? run.ate->rmse : -1.0);
       EXPECT_GE(ref.windows, 15);
+      std::printf("  reference disagreement %.4g m RMS (max %.4g) over %.3g m, %d poses\n",
+                  run.reference_rms_m, run.reference_max_m, run.reference_path_m,
+                  run.reference_pairs);
+      EXPECT_GE(run.reference_pairs, 20);
       if (name == "clean") {
         EXPECT_EQ(run.accel_relabelling, "");
+        EXPECT_EQ(run.reference_disagreement, "");
         testing::MutatedSource again = Mutated(mutate);
         const lioapp::RunSummary plain = lioapp::RunOdometry(again, config);
         EXPECT_EQ(plain.accel_reference_scans, 0);
@@ -94,6 +103,57 @@ TEST(AccelReference, ASwappedAccelerometerIsWarnedCleanIsNotAndTheEstimateIsUnch
           EXPECT_EQ(run.frames.warning, "");
         }
       }
+    }
+  }
+}
+
+TEST(AccelReference, ADepartureFromTheReferenceIsWarnedAboveItsFractionOfThePath) {
+  lioapp::ReferenceDisagreement d;
+  d.pairs = 80;
+  d.path_m = 10.0;
+  d.rms_m = 2.0;
+  d.max_m = 4.5;
+  const std::string w = lioapp::DisagreementWarning(d, 80);
+  EXPECT_NE(w.find("the estimate departs from a lidar + gyro reference (no accelerometer in it) by "
+                   "2 m RMS (max 4.5 m) over the first 80 scans (20.0 % of its 10 m path; "
+                   "threshold 15.0 %)"),
+            std::string::npos)
+      << w;
+  d.rms_m = 0.72;  // 7.2 %: the largest clean run measured (a baseline town run, bad-input.md)
+  EXPECT_EQ(lioapp::DisagreementWarning(d, 80), "");
+  d.rms_m = 2.0;
+  d.path_m = 0.5;  // hardly moved: the fraction is not judged
+  EXPECT_EQ(lioapp::DisagreementWarning(d, 80), "");
+  EXPECT_EQ(lioapp::DisagreementWarning(lioapp::ReferenceDisagreement(), 80), "");
+}
+
+// The medium box sequence at 32 beams over 8 s: a reference good to 1-2 cm, so that a baseline run
+// that follows a flipped accelerometer away (ATE ~5 m) departs from it by more than the path.
+TEST(AccelReference, AFlippedAccelerometerThatTheBaselineFollowsDepartsFromTheReference) {
+  for (const auto& [name, mutate] : testing::AccelerometerFaults()) {
+    if (name == "x and z swapped") continue;  // the relabelling's case, 0.4 % of the path here
+    SCOPED_TRACE(name);
+    sim::SimConfig c = testing::ShortMediumSequence();
+    c.duration_s = 8.0;
+    c.lidar.beams = 32;
+    c.lidar.firing_decimation = 2;
+    testing::MutatedSource source = testing::AccelMutatedSource(c, mutate);
+    const lioapp::RunSummary run = lioapp::RunOdometry(
+        source, testing::SimLioConfig().ForMethod(LioMethod::kImuInput), WithReference());
+    std::printf("imu_input, %s: %.4g m RMS (max %.4g) over %.3g m; ATE %.4f\n", name.c_str(),
+                run.reference_rms_m, run.reference_max_m, run.reference_path_m,
+                run.ate ? run.ate->rmse : -1.0);
+    EXPECT_GE(run.reference_path_m, 5.0);
+    if (name == "clean") {
+      // Measured 0.014 m over 7.35 m (0.19 %).
+      EXPECT_LT(run.reference_rms_m, 0.02 * run.reference_path_m);
+      EXPECT_EQ(run.reference_disagreement, "");
+    } else {
+      // Measured 8.5 m over 7.35 m (116 %).
+      EXPECT_NE(
+          run.reference_disagreement.find("the estimate departs from a lidar + gyro reference"),
+          std::string::npos)
+          << run.reference_disagreement;
     }
   }
 }
