@@ -71,44 +71,6 @@ double Mean(const std::vector<double>& v) {
 
 namespace {
 
-// The truth pose at exactly (within 1 ms) t, if there is one.
-std::optional<SE3> TruthPoseAt(const std::vector<io::StampedPose>& truth, int64_t t) {
-  const auto it = std::lower_bound(truth.begin(), truth.end(), t,
-                                   [](const io::StampedPose& q, int64_t x) { return q.t_ns < x; });
-  if (it != truth.end() && std::llabs(it->t_ns - t) <= 1000000) return it->pose;
-  if (it != truth.begin() && std::llabs((it - 1)->t_ns - t) <= 1000000) return (it - 1)->pose;
-  return std::nullopt;
-}
-
-// NEES of the scans' pose covariances against the truth T_world_lidar, the map frame anchored
-// at the first estimated scan (where the estimate is the identity, held constant).
-void PoseNees(const std::vector<lio::ScanResult>& scans, const std::vector<io::StampedPose>& truth,
-              const SE3& T_imu_lidar, RunSummary* run) {
-  std::optional<SE3> T_wm;
-  const SE3 T_lidar_imu = T_imu_lidar.Inverse();
-  for (const lio::ScanResult& r : scans) {
-    if (r.status == lio::ScanStatus::kFailed) continue;
-    const std::optional<SE3> T_wl = TruthPoseAt(truth, r.t_ns);
-    if (!T_wl) continue;
-    if (!T_wm) {  // the first estimate: T_mr = T_mr(first)
-      T_wm = *T_wl * T_lidar_imu * r.T_mr.Inverse();
-      continue;
-    }
-    if (!r.has_pose_covariance) continue;
-    const SE3 T_mr_true = T_wm->Inverse() * *T_wl * T_lidar_imu;
-    const Vec6 e = (T_mr_true * r.T_mr.Inverse()).Log();
-    const Mat6& S = r.pose_covariance;
-    run->nees.push_back(e.dot(S.ldlt().solve(e)));
-    run->nees_translation.push_back(
-        e.head<3>().dot(S.topLeftCorner<3, 3>().ldlt().solve(Vec3(e.head<3>()))));
-    run->nees_rotation.push_back(
-        e.tail<3>().dot(S.bottomRightCorner<3, 3>().ldlt().solve(Vec3(e.tail<3>()))));
-    for (int i = 0; i < 6; ++i) {
-      if (std::abs(e[i]) <= 3.0 * std::sqrt(S(i, i))) ++run->nees_inside_3sigma[size_t(i)];
-    }
-  }
-}
-
 // T_world_lidar of a scan: T_mr with the extrinsic estimated at that scan when it is estimated,
 // else the run's.
 SE3 LidarPose(const lio::ScanResult& r, const SE3& T_imu_lidar) {
@@ -435,7 +397,13 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     const AteResult live = EvaluateAte(run.live_trajectory, *truth);
     if (live.pairs >= 3) run.live_ate = live;
     run.drift_per_100m = DriftPer100m(run.trajectory, *truth);
-    if (config.pose_covariance) PoseNees(run.scans, *truth, T_imu_lidar, &run);
+    if (config.pose_covariance) {
+      PoseNees n = EvaluatePoseNees(run.scans, *truth, T_imu_lidar);
+      run.nees = std::move(n.pose);
+      run.nees_translation = std::move(n.translation);
+      run.nees_rotation = std::move(n.rotation);
+      run.nees_inside_3sigma = n.inside_3sigma;
+    }
   }
   for (const io::ImuInfo& info : source.Imus()) {
     run.true_biases.push_back(info.true_bias);

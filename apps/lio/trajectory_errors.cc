@@ -123,4 +123,46 @@ void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>
   io::CloseChecked(f, path);
 }
 
+namespace {
+
+// The truth pose at exactly (within 1 ms) t, if there is one.
+std::optional<SE3> TruthPoseAt(const std::vector<io::StampedPose>& truth, int64_t t) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                                   [](const io::StampedPose& q, int64_t x) { return q.t_ns < x; });
+  if (it != truth.end() && std::llabs(it->t_ns - t) <= 1000000) return it->pose;
+  if (it != truth.begin() && std::llabs((it - 1)->t_ns - t) <= 1000000) return (it - 1)->pose;
+  return std::nullopt;
+}
+
+}  // namespace
+
+PoseNees EvaluatePoseNees(const std::vector<lio::ScanResult>& scans,
+                          const std::vector<io::StampedPose>& truth, const SE3& T_imu_lidar) {
+  PoseNees out;
+  std::optional<SE3> T_wm;
+  const SE3 T_lidar_imu = T_imu_lidar.Inverse();
+  for (const lio::ScanResult& r : scans) {
+    if (r.status == lio::ScanStatus::kFailed) continue;
+    const std::optional<SE3> T_wl = TruthPoseAt(truth, r.t_ns);
+    if (!T_wl) continue;
+    if (!T_wm) {  // the first estimate: T_mr = T_mr(first)
+      T_wm = *T_wl * T_lidar_imu * r.T_mr.Inverse();
+      continue;
+    }
+    if (!r.has_pose_covariance) continue;
+    const SE3 T_mr_true = T_wm->Inverse() * *T_wl * T_lidar_imu;
+    const Vec6 e = (T_mr_true * r.T_mr.Inverse()).Log();
+    const Mat6& S = r.pose_covariance;
+    out.pose.push_back(e.dot(S.ldlt().solve(e)));
+    out.translation.push_back(
+        e.head<3>().dot(S.topLeftCorner<3, 3>().ldlt().solve(Vec3(e.head<3>()))));
+    out.rotation.push_back(
+        e.tail<3>().dot(S.bottomRightCorner<3, 3>().ldlt().solve(Vec3(e.tail<3>()))));
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(e[i]) <= 3.0 * std::sqrt(S(i, i))) ++out.inside_3sigma[size_t(i)];
+    }
+  }
+  return out;
+}
+
 }  // namespace ctlio::lioapp

@@ -3,12 +3,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "ctlio/io/dataset.h"
+#include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lioapp {
 
@@ -38,5 +40,17 @@ std::optional<double> DriftPer100m(const std::vector<io::StampedPose>& estimate,
 // nearest truth pose. Poses outside the truth are left out. Read by tools/plot_odometry.py.
 void WritePoseErrors(const std::string& path, const std::vector<io::StampedPose>& estimate,
                      const std::vector<io::StampedPose>& truth, const Eigen::Matrix4d& alignment);
+
+// NEES of the scans' pose covariances against the truth T_world_lidar (RunSummary::nees…), the
+// map frame anchored at the first estimated scan (where the estimate is the identity, held
+// constant); failed scans, scans without a truth pose within 1 ms or without a covariance are
+// left out.
+struct PoseNees {
+  std::vector<double> pose, translation, rotation;
+  // Per axis of ε = [ρ; φ]: the scans whose error lies within ±3σ of that axis (of pose.size()).
+  std::array<size_t, 6> inside_3sigma{};
+};
+PoseNees EvaluatePoseNees(const std::vector<lio::ScanResult>& scans,
+                          const std::vector<io::StampedPose>& truth, const SE3& T_imu_lidar);
 
 }  // namespace ctlio::lioapp
