@@ -58,7 +58,7 @@ lio::OdometryConfig ReferenceConfig(lio::OdometryConfig c) {
 
 AccelReference::AccelReference(const lio::OdometryConfig& config, size_t max_scans)
     : odometry_(std::make_unique<lio::LioOdometry>(ReferenceConfig(config))),
-      frames_(config.ImuPose(0)),
+      frames_(config.ImuPose(0), 0, {}, config.calibration.TimeOffset(0)),
       max_scans_(max_scans) {}
 
 AccelReference::~AccelReference() = default;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include "ctlio/factors/imu/saturating_ns.h"
 #include "ctlio/manifolds/so3.h"
 
 namespace ctlio::lioapp {
@@ -100,13 +101,19 @@ double FixedMapSquares(const Eigen::Matrix<double, 12, 12>& N,
 }  // namespace
 
 FrameConsistencyCheck::FrameConsistencyCheck(const SE3& T_robot_imu, int imu,
-                                             const FrameConsistencyOptions& options)
-    : T_ri_(T_robot_imu), imu_(imu), options_(options) {}
+                                             const FrameConsistencyOptions& options,
+                                             double clock_offset_s)
+    : T_ri_(T_robot_imu),
+      imu_(imu),
+      options_(options),
+      clock_offset_ns_(std::isfinite(clock_offset_s) ? std::llround(clock_offset_s * 1e9) : 0) {}
 
 void FrameConsistencyCheck::AddImu(const imu::ImuSample& sample) {
   if (sample.imu != imu_ || !sample.gyro.allFinite() || !sample.accel.allFinite()) return;
-  if (!samples_.empty() && sample.t_ns <= samples_.back().t_ns) return;
-  samples_.push_back(sample);
+  imu::ImuSample on_lidar_clock = sample;
+  on_lidar_clock.t_ns = SaturatingAddNs(sample.t_ns, clock_offset_ns_);
+  if (!samples_.empty() && on_lidar_clock.t_ns <= samples_.back().t_ns) return;
+  samples_.push_back(on_lidar_clock);
   Process();
 }
 

@@ -82,8 +82,13 @@ void WriteFrameConsistency(const FrameConsistency& r, std::ostream& out);
 
 class FrameConsistencyCheck {
  public:
+  // `clock_offset_s`: the IMU's configured clock offset δ (calibration.time_offset_s): a sample
+  // stamped t on the IMU's clock is placed at t + δ on the lidar's (calibration_options.h), as the
+  // estimator places it. Without it a configured offset reads as a frame defect: 20 ms at the fast
+  // regime's 2 rad/s is a 2.3° rotation between the gyro's spans and the poses'.
   explicit FrameConsistencyCheck(const SE3& T_robot_imu = SE3(), int imu = 0,
-                                 const FrameConsistencyOptions& options = {});
+                                 const FrameConsistencyOptions& options = {},
+                                 double clock_offset_s = 0.0);
   // The samples of every IMU, in time order (others than `imu` are ignored).
   void AddImu(const imu::ImuSample& sample);
   // A pose the lidar registered (status ok), in time order; T_mr of the robot frame.
@@ -105,6 +110,7 @@ class FrameConsistencyCheck {
   SE3 T_ri_;
   int imu_;
   FrameConsistencyOptions options_;
+  int64_t clock_offset_ns_;
   std::deque<imu::ImuSample> samples_;
   std::deque<Pose> poses_;
   size_t next_window_ = 0, next_span_ = 0;  // index in poses_ of the next window's / span's first
