@@ -46,6 +46,22 @@ std::string DisagreementWarning(const ReferenceDisagreement& d, int scans,
   return text;
 }
 
+std::string ReferenceRanOff(const ReferenceDisagreement& d, const ReferenceTrustOptions& options) {
+  if (d.pairs == 0 || d.extent_m < options.min_extent_m ||
+      !(d.extent_m > options.max_extent_ratio * d.estimate_extent_m)) {
+    return "";
+  }
+  char text[600];
+  std::snprintf(text, sizeof(text),
+                "the lidar + gyro reference went %.3g m from its start where the estimate went "
+                "%.3g m (%.2fx; more than %.2fx): the reference ran off on its own (no "
+                "accelerometer in it; a sparse lidar), so neither the relabelling nor the "
+                "departure is judged",
+                d.extent_m, d.estimate_extent_m, d.extent_m / std::max(d.estimate_extent_m, 1e-12),
+                options.max_extent_ratio);
+  return text;
+}
+
 namespace {
 lio::OdometryConfig ReferenceConfig(lio::OdometryConfig c) {
   c.method = lio::LioMethod::kLidarGyro;
@@ -96,6 +112,7 @@ ReferenceDisagreement AccelReference::Disagreement() const {
   const SE3* ref0 = nullptr;
   const SE3* est0 = nullptr;
   Vec3 previous = Vec3::Zero();
+  Vec3 previous_estimate = Vec3::Zero();
   double sum_sq = 0.0;
   for (const auto& [t, T] : reference_poses_) {
     const auto it = estimate.find(t);
@@ -107,8 +124,14 @@ ReferenceDisagreement AccelReference::Disagreement() const {
     const Vec3 p_ref = (ref0->Inverse() * T).translation();
     const Vec3 p_est = (est0->Inverse() * *it->second).translation();
     const double e = (p_est - p_ref).norm();
-    if (d.pairs > 0) d.path_m += (p_ref - previous).norm();
+    if (d.pairs > 0) {
+      d.path_m += (p_ref - previous).norm();
+      d.estimate_path_m += (p_est - previous_estimate).norm();
+    }
     previous = p_ref;
+    previous_estimate = p_est;
+    d.extent_m = std::max(d.extent_m, p_ref.norm());
+    d.estimate_extent_m = std::max(d.estimate_extent_m, p_est.norm());
     sum_sq += e * e;
     d.max_m = std::max(d.max_m, e);
     ++d.pairs;

@@ -45,7 +45,9 @@ std::string RelabellingWarning(const FrameConsistency& reference, int scans,
 // The method's positions against the reference's over the scans both registered, each trajectory
 // taken relative to its first common pose (T0⁻¹·T, so the map frames need not agree):
 //   rms_m = sqrt(mean |p_method − p_reference|²),  max_m = max |…|,
-//   path_m = Σ |p_reference(k) − p_reference(k−1)|  (the reference's distance travelled).
+//   path_m = Σ |p_reference(k) − p_reference(k−1)|  (the reference's distance travelled),
+//   estimate_path_m the same for the method's positions; extent_m / estimate_extent_m the
+//   largest distance from the first common position of the reference / the method.
 // A general statistic: any IMU defect that bends the fused trajectory away from what the lidar and
 // the gyro alone say (axes, units, extrinsic) shows, whether or not a relabelling explains it.
 struct ReferenceDisagreement {
@@ -53,7 +55,25 @@ struct ReferenceDisagreement {
   double rms_m = 0.0;
   double max_m = 0.0;
   double path_m = 0.0;
+  double estimate_path_m = 0.0;
+  double extent_m = 0.0;
+  double estimate_extent_m = 0.0;
 };
+
+// Whether the reference itself ran off: lidar + gyro alone, without the accelerometer's hold, can
+// lose its way where the lidar is sparse, and then both of its verdicts (relabelling, departure)
+// are about the reference, not the IMU. A method that follows a defective accelerometer goes
+// further than the reference; a reference that ran off goes further than the method. Judged by
+// the extent (farthest distance from the start), not the path, which a jittery but sound
+// reference lengthens. max_extent_ratio: see accel_reference_test.cc for the measured values.
+struct ReferenceTrustOptions {
+  double max_extent_ratio = 1.5;
+  double min_extent_m = 1.0;  // below it (hardly moved) not judged
+};
+// "" when the reference is trusted (or not enough to judge), else the note written instead of
+// the verdicts.
+std::string ReferenceRanOff(const ReferenceDisagreement& d,
+                            const ReferenceTrustOptions& options = {});
 
 struct DisagreementOptions {
   // rms_m / path_m above this warns; 0 = never. Measured over 80-scan references (8 s;

@@ -87,7 +87,12 @@ void WriteRunEvaluation(const RunSummary& run,
   if (run.reference_pairs > 0) {
     ev << "reference_disagreement_rms_m " << run.reference_rms_m
        << "\nreference_disagreement_max_m " << run.reference_max_m << "\nreference_path_m "
-       << run.reference_path_m << "\n";
+       << run.reference_path_m << "\nreference_estimate_path_m " << run.reference_estimate_path_m
+       << "\nreference_extent_m " << run.reference_extent_m << "\nreference_estimate_extent_m "
+       << run.estimate_extent_m << "\n";
+  }
+  if (!run.reference_ran_off.empty()) {
+    ev << "reference_ran_off \"" << run.reference_ran_off << "\"\n";
   }
   if (!run.reference_disagreement.empty()) {
     ev << "reference_disagreement \"" << run.reference_disagreement << "\"\n";

@@ -448,10 +448,14 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
       }
     }
   }
+  const ReferenceDisagreement d = reference ? reference->Disagreement() : ReferenceDisagreement();
+  run.reference_ran_off = ReferenceRanOff(d);
   if (reference || config.method == lio::LioMethod::kLidarGyro) {
     run.accel_reference = reference ? reference->Result() : run.frames;
     run.accel_reference_scans = reference ? reference->scans() : static_cast<int>(done);
-    run.accel_relabelling = RelabellingWarning(run.accel_reference, run.accel_reference_scans);
+    if (run.reference_ran_off.empty()) {
+      run.accel_relabelling = RelabellingWarning(run.accel_reference, run.accel_reference_scans);
+    }
     if (!run.accel_relabelling.empty()) {
       LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.accel_relabelling;
       if (io::WarningLimiter::Strict()) {
@@ -461,12 +465,16 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
     }
   }
   if (reference) {
-    const ReferenceDisagreement d = reference->Disagreement();
     run.reference_rms_m = d.rms_m;
     run.reference_max_m = d.max_m;
     run.reference_path_m = d.path_m;
+    run.reference_estimate_path_m = d.estimate_path_m;
+    run.reference_extent_m = d.extent_m;
+    run.estimate_extent_m = d.estimate_extent_m;
     run.reference_pairs = d.pairs;
-    run.reference_disagreement = DisagreementWarning(d, run.accel_reference_scans);
+    if (run.reference_ran_off.empty()) {
+      run.reference_disagreement = DisagreementWarning(d, run.accel_reference_scans);
+    }
     if (!run.reference_disagreement.empty()) {
       LOG(WARNING) << source.Name() << ": " << run.method << ": " << run.reference_disagreement;
     }

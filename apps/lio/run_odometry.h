@@ -169,6 +169,8 @@ struct RunSummary {
   // The method's positions against that reference's (accel_reference.h: RMS, max, path) and the
   // warning when they part by more than the threshold (empty otherwise); not a failure.
   double reference_rms_m = 0.0, reference_max_m = 0.0, reference_path_m = 0.0;
+  double reference_estimate_path_m = 0.0, reference_extent_m = 0.0, estimate_extent_m = 0.0;
+  std::string reference_ran_off;  // the reference travelled further than the estimate: not judged
   int reference_pairs = 0;
   std::string reference_disagreement;
   // The run is a failure if a scan failed after initialisation, the ATE exceeds `failure_ate`

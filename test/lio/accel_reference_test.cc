@@ -80,10 +80,13 @@ TEST(AccelReference, ASwappedAccelerometerIsWarnedCleanIsNotAndTheEstimateIsUnch
           ref.best_relabelling.c_str(), ref.best_relabelling_rms, ref.free_rms,
           run.frames.identity_rms, run.ate ? run.ate->rmse : -1.0);
       EXPECT_GE(ref.windows, 15);
-      std::printf("  reference disagreement %.4g m RMS (max %.4g) over %.3g m, %d poses\n",
-                  run.reference_rms_m, run.reference_max_m, run.reference_path_m,
-                  run.reference_pairs);
+      std::printf(
+          "  reference disagreement %.4g m RMS (max %.4g) over %.3g m, %d poses; extent %.3g m "
+          "(estimate %.3g m)\n",
+          run.reference_rms_m, run.reference_max_m, run.reference_path_m, run.reference_pairs,
+          run.reference_extent_m, run.estimate_extent_m);
       EXPECT_GE(run.reference_pairs, 20);
+      EXPECT_EQ(run.reference_ran_off, "");
       if (name == "clean") {
         EXPECT_EQ(run.accel_relabelling, "");
         EXPECT_EQ(run.reference_disagreement, "");
@@ -127,6 +130,30 @@ TEST(AccelReference, ADepartureFromTheReferenceIsWarnedAboveItsFractionOfThePath
   EXPECT_EQ(lioapp::DisagreementWarning(lioapp::ReferenceDisagreement(), 80), "");
 }
 
+// A reference that went further from its start than the estimate ran off on its own: not judged.
+TEST(AccelReference, AReferenceThatWentFurtherThanTheEstimateIsNotJudged) {
+  lioapp::ReferenceDisagreement d;
+  d.pairs = 100;
+  d.extent_m = 40.0;
+  d.estimate_extent_m = 8.0;
+  const std::string note = lioapp::ReferenceRanOff(d);
+  EXPECT_NE(note.find("the lidar + gyro reference went 40 m from its start where the estimate "
+                      "went 8 m (5.00x; more than 1.50x)"),
+            std::string::npos)
+      << note;
+  // A method that follows a defective accelerometer goes further than the reference: judged.
+  d.extent_m = 7.0;
+  d.estimate_extent_m = 14.9;
+  EXPECT_EQ(lioapp::ReferenceRanOff(d), "");
+  // Within the ratio, or hardly moved: judged / not judged either way, no note.
+  d.extent_m = 8.8;
+  EXPECT_EQ(lioapp::ReferenceRanOff(d), "");
+  d.extent_m = 0.9;
+  d.estimate_extent_m = 0.1;
+  EXPECT_EQ(lioapp::ReferenceRanOff(d), "");
+  EXPECT_EQ(lioapp::ReferenceRanOff(lioapp::ReferenceDisagreement()), "");
+}
+
 // The medium box sequence at 32 beams over 8 s: a reference good to 1-2 cm, so that a baseline run
 // that follows a flipped accelerometer away (ATE ~5 m) departs from it by more than the path.
 TEST(AccelReference, AFlippedAccelerometerThatTheBaselineFollowsDepartsFromTheReference) {
@@ -140,10 +167,14 @@ TEST(AccelReference, AFlippedAccelerometerThatTheBaselineFollowsDepartsFromTheRe
     testing::MutatedSource source = testing::AccelMutatedSource(c, mutate);
     const lioapp::RunSummary run = lioapp::RunOdometry(
         source, testing::SimLioConfig().ForMethod(LioMethod::kImuInput), WithReference());
-    std::printf("imu_input, %s: %.4g m RMS (max %.4g) over %.3g m; ATE %.4f\n", name.c_str(),
-                run.reference_rms_m, run.reference_max_m, run.reference_path_m,
-                run.ate ? run.ate->rmse : -1.0);
+    std::printf(
+        "imu_input, %s: %.4g m RMS (max %.4g) over %.3g m (estimate %.3g m); extent %.3g m "
+        "(estimate %.3g m); ATE %.4f\n",
+        name.c_str(), run.reference_rms_m, run.reference_max_m, run.reference_path_m,
+        run.reference_estimate_path_m, run.reference_extent_m, run.estimate_extent_m,
+        run.ate ? run.ate->rmse : -1.0);
     EXPECT_GE(run.reference_path_m, 5.0);
+    EXPECT_EQ(run.reference_ran_off, "");
     if (name == "clean") {
       // Measured 0.014 m over 7.35 m (0.19 %).
       EXPECT_LT(run.reference_rms_m, 0.02 * run.reference_path_m);
