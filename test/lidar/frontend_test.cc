@@ -92,8 +92,17 @@ TEST(Frontend, PlaneFitRecoversNormalAndPlanarity) {
   EXPECT_GE(fit.sigma2, fit.sigma3);
   const double a2d = (fit.sigma2 - fit.sigma3) / fit.sigma1;
   EXPECT_DOUBLE_EQ(fit.planarity_weight, a2d * a2d);
+  // The middle axis lies in the plane, a unit vector orthogonal to the normal.
+  EXPECT_NEAR(fit.middle_axis.norm(), 1.0, 1e-12);
+  EXPECT_LT(std::abs(fit.middle_axis.dot(normal)), 0.01);
+  EXPECT_LT(std::abs(fit.middle_axis.dot(fit.normal)), 1e-9);
   ASSERT_TRUE(FitPlane(Neighbours(line), &fit));
   EXPECT_LT(fit.planarity_weight, 0.01);
+  // A line's normal and middle axis are the two directions across it (where the fit across a
+  // ring line probes): both orthogonal to the line's direction e1.
+  EXPECT_LT(std::abs(fit.normal.dot(e1)), 0.05);
+  EXPECT_LT(std::abs(fit.middle_axis.dot(e1)), 0.05);
+  EXPECT_NEAR(fit.middle_axis.norm(), 1.0, 1e-12);
   ASSERT_TRUE(FitPlane(Neighbours(blob), &fit));
   EXPECT_LT(fit.planarity_weight, 0.3);
   EXPECT_FALSE(FitPlane(Neighbours({origin, origin}), &fit));

@@ -123,6 +123,11 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.001);
   EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
+  // The model's misfit (misfit_covariance.h): Singer-LIO's on the VLP-16, off by default.
+  EXPECT_TRUE(v.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
+  EXPECT_FALSE(v.ForMethod(LioMethod::kImuInput).pose_covariance_misfit);
+  EXPECT_TRUE(c.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
+  EXPECT_FALSE(OdometryConfig().pose_covariance_misfit);
   // The line-neighbourhood plane fit is both methods' (vlp16.yaml's lidar_frontend).
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.line_neighbourhood_ratio, 0.1);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.1);

@@ -1,6 +1,5 @@
 #include "ctlio/solvers/lio/frontend.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -325,20 +324,15 @@ bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
 
 bool PlaneAssociator::FitAcrossLine(const Vec3& p_map, PlaneFit* plane) {
   // The line's direction is the neighbours' largest principal axis; the two axes across it (the
-  // fit's normal and its middle axis) are where another ring of the same surface can lie, one
-  // ring spacing (1–2 m for a VLP-16's floor) away on either side.
-  Vec3 mean;
-  Mat3 covariance;
-  MomentsOf(neighbours_, &mean, &covariance);
-  Eigen::SelfAdjointEigenSolver<Mat3> es;
-  es.computeDirect(covariance);
-  if (es.info() != Eigen::Success) return false;
+  // kNN fit's normal and its middle axis, *plane on entry) are where another ring of the same
+  // surface can lie, one ring spacing (1–2 m for a VLP-16's floor) away on either side.
+  const Vec3 across[2] = {plane->normal, plane->middle_axis};
   const double step = map_.options().voxel_size;
   const double max_squared = 4.0 * step * step;  // within two map voxels of p_map
   wide_ = neighbours_;
   for (int axis = 0; axis < 2; ++axis) {
     for (const double side : {-1.0, 1.0}) {
-      const Vec3 probe = p_map + side * step * es.eigenvectors().col(axis);
+      const Vec3 probe = p_map + side * step * across[axis];
       map_.KNearest(probe, options_.max_neighbours, &probe_);
       for (const auto& nb : probe_) {
         if ((nb.point - p_map).squaredNorm() > max_squared) continue;

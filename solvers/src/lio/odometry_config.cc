@@ -226,7 +226,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"pose_covariance_lidar_floor_rad", SetFromYaml(&c->pose_covariance_lidar_floor_rad)},
            {"pose_covariance_map_sigma_m", SetFromYaml(&c->pose_covariance_map_sigma_m)},
            {"pose_covariance_map_sigma_rad", SetFromYaml(&c->pose_covariance_map_sigma_rad)},
-           {"pose_covariance_map_growth", SetFromYaml(&c->pose_covariance_map_growth)}});
+           {"pose_covariance_map_growth", SetFromYaml(&c->pose_covariance_map_growth)},
+           {"pose_covariance_misfit", SetFromYaml(&c->pose_covariance_misfit)}});
     } else if (key == "extrinsic") {
       top->have_extrinsic = true;
       ReadSection(v, key, source,

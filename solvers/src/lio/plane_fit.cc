@@ -21,6 +21,7 @@ bool FitPlaneFromMoments(const Vec3& mean, const Mat3& covariance, PlaneFit* pla
   plane->planarity_weight = a2d * a2d;
   plane->centroid = mean;
   plane->normal = es.eigenvectors().col(0).normalized();
+  plane->middle_axis = es.eigenvectors().col(1);
   return true;
 }
 

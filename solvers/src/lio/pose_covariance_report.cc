@@ -1,16 +1,61 @@
 #include "ctlio/solvers/lio/pose_covariance_report.h"
 
+#include <algorithm>
+#include <set>
 #include <vector>
 
+#include "ctlio/solvers/lio/imu_consistency.h"
+#include "ctlio/solvers/lio/misfit_covariance.h"
 #include "ctlio/solvers/lio/pose_covariance.h"
 
 namespace ctlio::lio {
 namespace {
 
-// Σ = Σ_rel + Σ_map: the configured map error and the one the map was built with (the latter
-// before this scan's insertion is accounted, map_growth_covariance.h (1)).
-Mat6 WithMapError(const OdometryConfig& config, const Mat6& relative,
-                  PoseCovarianceModels* models) {
+// With window.pose_covariance_misfit, Σ_rel plus what the newest interval's motion model was
+// worth where its IMU residuals reject it (misfit_covariance.h (1)); then Σ = Σ_rel + Σ_map: the
+// configured map error and the one the map was built with (the latter before this scan's
+// insertion is accounted, map_growth_covariance.h (1)).
+std::optional<Mat6> WithMisfitAndMapError(const OdometryConfig& config, const Mat6& window_only,
+                                          double lidar_scale, const RegistrationSummary& registered,
+                                          const Estimator& estimator,
+                                          ceres::ResidualBlockId marginal_prior, const SE3& T_mr,
+                                          PoseCovarianceModels* models, SlidingWindow* window) {
+  Mat6 relative = window_only;
+  if (config.pose_covariance_misfit) {
+    // Each sensor by its own test (misfit_covariance.h). With a gyro χ² of its own (Singer-LIO)
+    // the accelerometer tests the translational motion model: its rejection releases the motion
+    // prior and the bias walk with it, of which the translation block is kept; the gyro tests
+    // the rotation (its blocks, or with interval batches the same blocks, whose rotation block
+    // is kept). One factor of both sensors (the baseline's preintegration, no gyro χ² of its
+    // own) releases the whole increase.
+    const ImuTermBlocks& imu = estimator.NewestImuBlocks();
+    ChiSquare accel, gyro;
+    EvaluateImuChiSquare(&window->problem(), imu, &accel, &gyro);
+    const double f_accel = MisfitFactor(accel.chi2, accel.dof);
+    const double f_gyro = MisfitFactor(gyro.chi2, gyro.dof);
+    if (f_accel > 1.0 || f_gyro > 1.0) {
+      std::vector<ceres::ResidualBlockId> motion = MotionModelBlocks(
+          *window, estimator.NewestKeys(), registered.lidar_blocks, marginal_prior);
+      const std::set<ceres::ResidualBlockId> gyro_blocks(imu.gyro.begin(), imu.gyro.end());
+      motion.erase(std::remove_if(motion.begin(), motion.end(),
+                                  [&](ceres::ResidualBlockId r) { return gyro_blocks.count(r); }),
+                   motion.end());
+      const auto increase = [&](const std::vector<ceres::ResidualBlockId>& blocks, double f) {
+        return MisfitCovarianceIncrease(*window, estimator.NewestPoseKey(), registered.lidar_blocks,
+                                        lidar_scale, {ScaledGroup{blocks, f}}, T_mr,
+                                        estimator.NewestPoseTangentFromBody());
+      };
+      const std::optional<Mat6> d_accel = increase(motion, f_accel);
+      const std::optional<Mat6> d_gyro = increase(imu.gyro.empty() ? motion : imu.gyro, f_gyro);
+      if (!d_accel || !d_gyro) return std::nullopt;
+      if (gyro.dof == 0) {
+        relative += *d_accel;
+      } else {
+        relative.topLeftCorner<3, 3>() += d_accel->topLeftCorner<3, 3>();
+        relative.bottomRightCorner<3, 3>() += d_gyro->bottomRightCorner<3, 3>();
+      }
+    }
+  }
   if (config.pose_covariance_map_growth > 0.0) models->growth.Registered(relative);
   return relative + MapCovariance(config) + models->growth.map();
 }
@@ -51,7 +96,8 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
         models->adaptive.Compute(window, pose, lidar_estimate, lidar, imu.accel, imu.gyro,
                                  marginal_prior, T_mr, tangent_from_body);
     if (!S) return std::nullopt;
-    return WithMapError(config, *S, models);
+    return WithMisfitAndMapError(config, *S, models->adaptive.lidar(), registered, estimator,
+                                 marginal_prior, T_mr, models, window);
   }
   const double scale = config.pose_covariance_lidar_scale;
   const double floor_m = config.pose_covariance_lidar_floor_m;
@@ -66,7 +112,8 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
           ? PoseCovariance(&window->problem(), window->State(pose), T_mr, tangent_from_body)
           : ScaledPoseCovariance(*window, pose, lidar, scale, T_mr, tangent_from_body);
   if (!S) return std::nullopt;
-  return WithMapError(config, *S, models);
+  return WithMisfitAndMapError(config, *S, scale, registered, estimator, marginal_prior, T_mr,
+                               models, window);
 }
 
 Mat6 MapCovariance(const OdometryConfig& config) {

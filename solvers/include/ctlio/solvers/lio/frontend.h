@@ -67,7 +67,8 @@ class PlaneAssociator {
  private:
   // The plane of the map points around p_map across the line its k nearest neighbours
   // (neighbours_) form (LidarFrontendOptions::line_neighbourhood_ratio); false when they are a
-  // line too.
+  // line too. *plane on entry: the kNN fit of neighbours_ (its normal and middle axis span the
+  // directions across the line); replaced by the wider fit on success.
   bool FitAcrossLine(const Vec3& p_map, PlaneFit* plane);
 
   const VoxelMap& map_;

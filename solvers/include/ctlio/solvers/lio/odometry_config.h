@@ -228,6 +228,11 @@ struct OdometryConfig {
   // For sparse sensors whose start-up error stays in the map (docs/experiments/covariance.md,
   // "16 beams"). 0: none. The estimate is unchanged.
   double pose_covariance_map_growth = 0.0;
+  // window.pose_covariance_misfit: where the newest interval's IMU χ² rejects the motion model
+  // (above its 99.9 % quantile and its dof), the covariance gains what that model's information
+  // was worth, the model's variance scaled by χ²/dof (misfit_covariance.h; before the map's error,
+  // so the map growth carries it). The estimate is unchanged.
+  bool pose_covariance_misfit = false;
 
   // How many of the newest ScanResults results() keeps (LioOdometry, CalibratingOdometry; 0:
   // every one). Bounded so that the pipeline's memory does not grow with the length of the run

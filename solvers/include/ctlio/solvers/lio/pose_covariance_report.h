@@ -10,7 +10,9 @@
 // else the window as solved (pose_covariance_lidar_scale 1), or with the lidar blocks' variance
 // multiplied by that scale. Each adds the map's own error
 // (window.pose_covariance_map_sigma_m/_rad, and the map's error as it was built,
-// window.pose_covariance_map_growth: map_growth_covariance.h). Not the lidar term's plain χ²
+// window.pose_covariance_map_growth: map_growth_covariance.h); with window.pose_covariance_misfit,
+// the relative part grows where the scan's IMU χ² rejects the motion model
+// (misfit_covariance.h). Not the lidar term's plain χ²
 // (LidarChiSquareScale): its spread alone made the baseline 40× overconfident
 // (docs/experiments/covariance.md).
 #pragma once
