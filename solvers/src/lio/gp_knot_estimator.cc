@@ -24,7 +24,13 @@
 namespace ctlio::lio {
 
 GpKnotEstimator::GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& imu)
-    : config_(config), imu_(imu), model_(config.qc, config.alpha) {
+    : config_(config),
+      imu_(imu),
+      model_(config.qc, config.alpha),
+      accel_loss_(config.accel_loss_scale,
+                  config.method == LioMethod::kSingerLio ? config.accel_loss_relax_bias_sigma : 0.0,
+                  config.accel_loss_relaxed_scale,
+                  config.method == LioMethod::kSingerLio ? config.num_imus() : 0) {
   for (int j = 0; j < config_.num_imus(); ++j) {
     mountings_.push_back(imu::ImuMounting::FromPose(config_.ImuPose(j)));
   }
@@ -249,6 +255,7 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
       history_.pop_front();
     }
   }
+  UpdateAccelLoss(*window, result);
   const double t_prev = knots_.back().t;
   const int K = KnotsForScan(t_prev, scan.t_end);
   split_sweep_ = K > config_.knots_per_scan;
@@ -264,6 +271,20 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
     AddKnotAndFactors(t, window, result);
   }
   scan_knots_ = K;
+}
+
+void GpKnotEstimator::UpdateAccelLoss(const SlidingWindow& window, ScanResult* result) {
+  if (!accel_loss_.enabled()) return;
+  for (int j = 0; j < num_imus(); ++j) {
+    if (!accel_loss_.Watching(j)) continue;
+    // The newest knot's bias given everything so far: after the slide the window holds that knot
+    // and the marginal prior, so this linearises little more than the prior (an inverse of the
+    // knot's 18 + 6 per IMU dimensions, and only until the loss is relaxed).
+    const Eigen::MatrixXd P = window.Covariance({knots_.back().keys.Bias(j)});
+    accel_loss_.Observe(j, P.topLeftCorner<3, 3>());  // [b_a; b_g]
+  }
+  result->accel_loss_relaxed = accel_loss_.relaxed(0);
+  result->accel_bias_sigma = accel_loss_.relaxed(0) ? 0.0 : accel_loss_.last_sigma(0);
 }
 
 int GpKnotEstimator::KnotsForScan(double t_prev, double t_end) const {

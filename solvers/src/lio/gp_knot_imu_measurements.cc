@@ -38,8 +38,12 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
   std::vector<StateId> accel_states = gyro_states;
   accel_states.push_back(kGravityKey);
   // One loss per scan, shared by its accelerometer residuals (the window ref-counts it).
+  // Its scale: imu.accel_loss_scale, or the relaxed one once the bias is known (the window holds
+  // one interval, so the intervals added from then on are all of it; accel_loss_schedule.h).
+  const double accel_loss_scale =
+      config_.method == LioMethod::kSingerLio ? accel_loss_.scale(imu_index) : 0.0;
   std::unique_ptr<ceres::LossFunction> accel_loss(
-      config_.accel_loss_scale > 0 ? new ceres::CauchyLoss(config_.accel_loss_scale) : nullptr);
+      accel_loss_scale > 0 ? new ceres::CauchyLoss(accel_loss_scale) : nullptr);
   bool accel_loss_used = false;
   const gp::KnotBlocks knots = {prev.pose, prev.velocity, prev.acceleration,
                                 k.pose,    k.velocity,    k.acceleration};

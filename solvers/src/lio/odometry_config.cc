@@ -172,6 +172,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
       ReadSection(v, section, source,
                   {{"accel_variance", SetFromYaml(&c->accel_variance)},
                    {"accel_loss_scale", SetFromYaml(&c->accel_loss_scale)},
+                   {"accel_loss_relax_bias_sigma", SetFromYaml(&c->accel_loss_relax_bias_sigma)},
+                   {"accel_loss_relaxed_scale", SetFromYaml(&c->accel_loss_relaxed_scale)},
                    {"gyro_variance", SetFromYaml(&c->gyro_variance)},
                    {"bias_accel_walk", SetFromYaml(&c->bias_accel_walk)},
                    {"bias_gyro_walk", SetFromYaml(&c->bias_gyro_walk)},

@@ -20,6 +20,11 @@ void OdometryConfig::Validate() const {
   require((alpha.array() >= 0).all(), "gp.alpha must be >= 0 on every axis");
   require(accel_variance > 0 && gyro_variance > 0, "imu variances must be positive");
   require(accel_loss_scale >= 0, "imu.accel_loss_scale must be >= 0");
+  // σ of a bias in m/s²: above 10 the gate would open at the start, below 0 never (use 0: off).
+  require(accel_loss_relax_bias_sigma >= 0 && accel_loss_relax_bias_sigma <= 10,
+          "imu.accel_loss_relax_bias_sigma must be in [0, 10] m/s^2 (0: off)");
+  require(accel_loss_relaxed_scale >= 0 && accel_loss_relaxed_scale <= 1e3,
+          "imu.accel_loss_relaxed_scale must be in [0, 1000] (0: no loss once relaxed)");
   require(imu_residual_blocks == "sample" || imu_residual_blocks == "interval",
           "imu.residual_blocks must be sample or interval");
   require(gap_prediction_span >= 0 && gap_prediction_span <= 10,

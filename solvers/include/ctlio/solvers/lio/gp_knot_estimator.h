@@ -29,6 +29,7 @@
 #include "ctlio/factors/gp/knot_state.h"
 #include "ctlio/factors/gp/motion_model.h"
 #include "ctlio/factors/imu/imu_mounting.h"
+#include "ctlio/solvers/lio/accel_loss_schedule.h"
 #include "ctlio/solvers/lio/estimator.h"
 #include "ctlio/solvers/lio/state_keys.h"
 
@@ -119,6 +120,9 @@ class GpKnotEstimator final : public Estimator {
   void AddImuMeasurements(const Knot& prev, const Knot& k, int imu,
                           const std::vector<ImuSample>& samples, SlidingWindow* window,
                           ScanResult* result);
+  // Before a scan's knots: the accelerometer-bias covariance for the loss schedule (accel_loss_),
+  // while it watches, and what it decided into `result`.
+  void UpdateAccelLoss(const SlidingWindow& window, ScanResult* result);
   // Clock offsets in use (estimated or configured non-zero), and IMU j's current δ_j.
   bool time_offsets() const { return uses_imu() && time_offsets_; }
   double TimeOffset(int imu, const SlidingWindow& window) const;
@@ -145,6 +149,9 @@ class GpKnotEstimator final : public Estimator {
   // outage starts from reaches back to.
   std::deque<TimedState> history_;
   ImuTermBlocks imu_blocks_;  // those the last AddState added
+  // The accelerometer's Cauchy scale per IMU, relaxed once its bias is known
+  // (imu.accel_loss_relax_bias_sigma); read from the window before each AddState.
+  AccelLossSchedule accel_loss_;
 };
 
 }  // namespace ctlio::lio

@@ -50,8 +50,14 @@ struct OdometryConfig {
   Vec6 alpha = (Vec6() << 0, 0, 0, 100, 100, 100).finished();
 
   // --- IMU noise (SPEC §4 defaults: the paper's Newer College values).
-  double accel_variance = 0.156;    // (m/s²)², whitened error under a Cauchy loss
-  double accel_loss_scale = 1.0;    // Cauchy scale on the whitened accelerometer error; 0 = none
+  double accel_variance = 0.156;  // (m/s²)², whitened error under a Cauchy loss
+  double accel_loss_scale = 1.0;  // Cauchy scale on the whitened accelerometer error; 0 = none
+  // imu.accel_loss_relax_bias_sigma [m/s²], imu.accel_loss_relaxed_scale (Singer-LIO;
+  // accel_loss_schedule.h): once the window's marginal σ of the accelerometer bias (largest axis)
+  // is below the first, every later interval takes the second as its Cauchy scale (0: no loss).
+  // 0 = off: accel_loss_scale all run long.
+  double accel_loss_relax_bias_sigma = 0.0;
+  double accel_loss_relaxed_scale = 0.0;
   double gyro_variance = 4.326e-4;  // (rad/s)²
   // Bias random walk: variance accumulated per `bias_walk_period` seconds (the paper's per 0.1 s);
   // scaled by Δt between knots (SPEC §3) — the reference code does not scale it.
@@ -326,6 +332,11 @@ struct ScanResult {
   int accel_dof = 0;
   double gyro_chi2 = 0.0;
   int gyro_dof = 0;
+  // Singer-LIO with imu.accel_loss_relax_bias_sigma (accel_loss_schedule.h), IMU 0: this scan's
+  // accelerometer residuals took the relaxed scale, and the largest σ of the accelerometer bias
+  // [m/s²] the schedule read before the scan (0 once relaxed, or with the schedule off).
+  bool accel_loss_relaxed = false;
+  double accel_bias_sigma = 0.0;
   double milliseconds = 0.0;    // wall time of this scan, split into:
   double ms_preprocess = 0.0;   // range gate, subsampling, keypoints
   double ms_associate = 0.0;    // interpolation + kNN + plane fits, all rounds
