@@ -29,8 +29,7 @@ GpKnotEstimator::GpKnotEstimator(const OdometryConfig& config, const ImuBuffer& 
       model_(config.qc, config.alpha),
       accel_loss_(config.accel_loss_scale,
                   config.method == LioMethod::kSingerLio ? config.accel_loss_relax_bias_sigma : 0.0,
-                  config.accel_loss_relaxed_scale,
-                  config.method == LioMethod::kSingerLio ? config.num_imus() : 0) {
+                  config.accel_loss_relaxed_scale, config.num_imus()) {
   for (int j = 0; j < config_.num_imus(); ++j) {
     mountings_.push_back(imu::ImuMounting::FromPose(config_.ImuPose(j)));
   }

@@ -40,8 +40,7 @@ void GpKnotEstimator::AddImuMeasurements(const Knot& prev, const Knot& k, int im
   // One loss per scan, shared by its accelerometer residuals (the window ref-counts it).
   // Its scale: imu.accel_loss_scale, or the relaxed one once the bias is known (the window holds
   // one interval, so the intervals added from then on are all of it; accel_loss_schedule.h).
-  const double accel_loss_scale =
-      config_.method == LioMethod::kSingerLio ? accel_loss_.scale(imu_index) : 0.0;
+  const double accel_loss_scale = accel_loss_.scale(imu_index);
   std::unique_ptr<ceres::LossFunction> accel_loss(
       accel_loss_scale > 0 ? new ceres::CauchyLoss(accel_loss_scale) : nullptr);
   bool accel_loss_used = false;
