@@ -17,12 +17,13 @@
 namespace ctlio::lio {
 namespace {
 
-// The exact 0.999 quantiles (scipy.stats.chi2.ppf) of the IMU terms' dof: the baseline's
-// preintegrated factor (9), Singer-LIO's 20 samples of one sensor (60) and of both (120).
-TEST(MisfitCovariance, TheQuantileIsWithinOnePercentAndTheFactorNeedsBoth) {
-  EXPECT_NEAR(ChiSquareQuantile999(9), 27.877, 0.01 * 27.877);
-  EXPECT_NEAR(ChiSquareQuantile999(60), 99.607, 0.01 * 99.607);
-  EXPECT_NEAR(ChiSquareQuantile999(120), 173.617, 0.01 * 173.617);
+// The test at the 0.999 quantiles of the IMU terms' dof: the baseline's preintegrated factor (9:
+// 27.877), Singer-LIO's 20 samples of one sensor (60: 99.607) and of both (120: 173.617).
+TEST(MisfitCovariance, TheFactorNeedsBothTheTestAndAReducedChiSquareAboveOne) {
+  EXPECT_EQ(MisfitFactor(27.8, 9), 1.0);
+  EXPECT_DOUBLE_EQ(MisfitFactor(27.95, 9), 27.95 / 9.0);
+  EXPECT_EQ(MisfitFactor(173.5, 120), 1.0);
+  EXPECT_DOUBLE_EQ(MisfitFactor(173.75, 120), 173.75 / 120.0);
   // χ²/dof > 1 but within the test: no misfit (a 9-dof χ² exceeds 9 in 44 % of fits).
   EXPECT_EQ(MisfitFactor(20.0, 9), 1.0);
   EXPECT_DOUBLE_EQ(MisfitFactor(60.0, 9), 60.0 / 9.0);

@@ -1,8 +1,9 @@
 #include "ctlio/study/evaluation.h"
 
-#include <boost/math/distributions/chi_squared.hpp>
 #include <stdexcept>
 #include <string>
+
+#include "ctlio/solvers/chi_square.h"
 
 namespace ctlio::study {
 
@@ -68,9 +69,9 @@ double ErrorStatistics::FractionNeesInside(int first, int last) const {
 
 void NeesBounds(int m, int d, double p, double* lower, double* upper) {
   if (m <= 0 || d <= 0) throw std::invalid_argument(std::string(__FILE__) + ": NeesBounds");
-  const boost::math::chi_squared chi2(static_cast<double>(m) * d);
-  *lower = boost::math::quantile(chi2, 0.5 * p) / m;
-  *upper = boost::math::quantile(chi2, 1.0 - 0.5 * p) / m;
+  const double dof = static_cast<double>(m) * d;
+  *lower = ChiSquareQuantile(dof, 0.5 * p) / m;
+  *upper = ChiSquareQuantile(dof, 1.0 - 0.5 * p) / m;
 }
 
 double ErrorStatistics::NeesLower() const {

@@ -4,22 +4,15 @@
 #include <cmath>
 #include <set>
 
+#include "ctlio/solvers/chi_square.h"
 #include "ctlio/solvers/lio/adaptive_covariance.h"
 
 namespace ctlio::lio {
 
-double ChiSquareQuantile999(int dof) {
-  // Wilson–Hilferty: (χ²/k)^(1/3) is near normal with mean 1 − 2/(9k) and variance 2/(9k);
-  // z = 3.0902 is the standard normal's 0.999 quantile.
-  const double k = dof, v = 2.0 / (9.0 * k);
-  const double c = 1.0 - v + 3.0902 * std::sqrt(v);
-  return k * c * c * c;
-}
-
 double MisfitFactor(double chi2, int dof) {
   if (dof <= 0 || !std::isfinite(chi2)) return 1.0;
   const double reduced = chi2 / dof;
-  return reduced > 1.0 && chi2 > ChiSquareQuantile999(dof) ? reduced : 1.0;
+  return reduced > 1.0 && chi2 > ChiSquareQuantile(dof, 0.999) ? reduced : 1.0;
 }
 
 std::vector<ceres::ResidualBlockId> MotionModelBlocks(

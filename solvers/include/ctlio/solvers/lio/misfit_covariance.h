@@ -35,11 +35,8 @@
 
 namespace ctlio::lio {
 
-// q such that P(χ²_dof > q) = 0.001 (Wilson–Hilferty; within 1 % of the exact quantile for
-// dof ≥ 3). dof > 0.
-double ChiSquareQuantile999(int dof);
-
-// The variance factor f of (1): χ²/dof where χ² > ChiSquareQuantile999(dof) and χ²/dof > 1;
+// The variance factor f of (1): χ²/dof where χ² exceeds its 0.999 quantile (ChiSquareQuantile,
+// chi_square.h) and χ²/dof > 1;
 // else 1 (also for dof ≤ 0 or a non-finite χ²).
 double MisfitFactor(double chi2, int dof);
 
