@@ -8,8 +8,9 @@ sequence index and method, (1) a run calibrating from the wrong start (3 deg / 1
       --methods singer_lio,imu_input --workers 2
   tools/calibration_triples.py table --out DIR [--indices 0-9] [--runs]
 
-Run from the repository root (configs data/sim_lio.yaml,data/calibration.yaml). Each triple goes
-to DIR/REGIME/INDEX/METHOD/{cal,pasted,true}; finished runs are skipped, so a run can be resumed.
+Run from the repository root (configs data/sim_lio.yaml,data/calibration.yaml, or --config with a
+variant on top). Each triple goes to DIR/REGIME/INDEX/METHOD/{cal,pasted,true}; finished runs are
+skipped, so a run can be resumed.
 """
 import argparse
 import os
@@ -48,11 +49,14 @@ def run_triple(args, regime, index, method):
            "--plot=false", "--progress=false"]
     wrong = ["--sim_extrinsic_error=3deg,0.10m"]
     off, true_offset = os.path.join(args.out, "off.yaml"), os.path.join(args.out, "true_off.yaml")
-    runs = [("cal", wrong + ["--config", BASE]),
-            ("pasted", wrong + ["--config", ",".join([BASE, off, os.path.join(d, "cal",
+    base = args.config
+    runs = [("cal", wrong + ["--config", base]),
+            ("pasted", wrong + ["--config", ",".join([base, off, os.path.join(d, "cal",
                                                                                "calibration.yaml")])]),
-            ("true", ["--config", ",".join([BASE, off, true_offset])])]
+            ("true", ["--config", ",".join([base, off, true_offset])])]
     for name, extra in runs:
+        if name not in args.kinds.split(","):
+            continue
         if os.path.exists(os.path.join(d, name, "evaluation.txt")):
             continue
         with open(os.path.join(d, name + ".log"), "w") as log:
@@ -167,6 +171,11 @@ def main():
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--binary", default="build/apps/lio/ctlio_odometry")
     p.add_argument("--runs", action="store_true", help="table: one line per run as well")
+    p.add_argument("--kinds", default="cal,pasted,true",
+                   help="run: which runs of each triple (a variant of the calibrating configs can "
+                   "share the true-value runs of another directory: link them into DIR)")
+    p.add_argument("--config", default=BASE,
+                   help="run: the configs of every run (off.yaml and the rest come after them)")
     args = p.parse_args()
     if args.mode == "table":
         table(args)
