@@ -50,7 +50,7 @@ def run_triple(args, regime, index, method):
     wrong = ["--sim_extrinsic_error=3deg,0.10m"]
     off, true_offset = os.path.join(args.out, "off.yaml"), os.path.join(args.out, "true_off.yaml")
     base = args.config
-    runs = [("cal", wrong + ["--config", base]),
+    runs = [("cal", wrong + ["--config", base] + args.cal_args.split()),
             ("pasted", wrong + ["--config", ",".join([base, off, os.path.join(d, "cal",
                                                                                "calibration.yaml")])]),
             ("true", ["--config", ",".join([base, off, true_offset])])]
@@ -174,6 +174,9 @@ def main():
     p.add_argument("--kinds", default="cal,pasted,true",
                    help="run: which runs of each triple (a variant of the calibrating configs can "
                    "share the true-value runs of another directory: link them into DIR)")
+    p.add_argument("--cal_args", default="",
+                   help="run: more flags of the calibrating run, e.g. "
+                   "'--warmup_replay_adopt_after_s 6'")
     p.add_argument("--config", default=BASE,
                    help="run: the configs of every run (off.yaml and the rest come after them)")
     args = p.parse_args()
