@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "common/test_paths.h"
 #include "ctlio/sim/extrinsic_error.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -19,7 +20,7 @@ namespace ctlio::testing {
 // tables of docs/experiments were measured with).
 inline lio::OdometryConfig SimLioConfig() {
   lio::OdometryConfig config =
-      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+      lio::LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   // Also in the per-method configs (each a whole config, resolved when the file was read).
   const auto reduced = [](lio::OdometryConfig* c) {
     c->frontend.voxel_size = 0.5;

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "common/test_paths.h"
 #include "common/write_temp.h"
 #include "ctlio/factors/imu/gravity_initialization.h"
 #include "ctlio/factors/imu/imu_data.h"
@@ -26,7 +27,7 @@ using io::ReadVicon2gtCsv;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadToDeg = 180.0 / kPi;
 
-std::string DataDir() { return std::string(CTLIO_SHARED_DATA_DIR) + "/euroc_v1_01_easy"; }
+std::string DataDir() { return ctlio::testing::SharedDataDir() + "/euroc_v1_01_easy"; }
 
 bool HaveData() {
   return std::ifstream(DataDir() + "/imu0_data.csv").good() &&

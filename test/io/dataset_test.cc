@@ -16,6 +16,7 @@
 
 #include "common/expect_error.h"
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "ctlio/io/kitti.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/sim_folder.h"
@@ -355,7 +356,7 @@ TEST(BadInput, ImuBackwardsDuplicatedAndGaps) {
 }
 
 TEST(Kitti, RealSampleScansAndGroundTruth) {
-  const fs::path d = fs::path(CTLIO_SHARED_DATA_DIR) / "kitti_odom00_start";
+  const fs::path d = fs::path(ctlio::testing::SharedDataDir()) / "kitti_odom00_start";
   if (!fs::exists(d)) GTEST_SKIP() << "shared data folder absent: " << d;
   KittiReader r(d.string());
   ASSERT_EQ(r.NumScans(), 2u);

@@ -12,6 +12,7 @@
 
 #include "common/expect_error.h"
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 
 namespace ctlio::io {
 namespace {
@@ -76,8 +77,8 @@ TEST(PointCloudIo, PlyAndKittiBinRoundTrip) {
 }
 
 TEST(PointCloudIo, RealNewerCollegeSweepWithTimes) {
-  const fs::path d =
-      fs::path(CTLIO_SHARED_DATA_DIR) / "gtsam_points_lidar_samples" / "newer_college_2020_06";
+  const fs::path d = fs::path(ctlio::testing::SharedDataDir()) / "gtsam_points_lidar_samples" /
+                     "newer_college_2020_06";
   if (!fs::exists(d)) GTEST_SKIP() << "shared data folder absent: " << d;
   const PointCloud c =
       ReadKittiBin((d / "raw_00.bin").string(), 3, (d / "times_00.bin").string(), 1000);

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "ctlio/io/bag_writer.h"
 #include "ctlio/io/cdr_messages.h"
 #include "ctlio/io/newer_college.h"
@@ -99,7 +100,7 @@ TEST(Ros2BagTrajectory, EveryLayoutHandsTheOdometryTheSameFrames) {
 TEST(Ros2BagTrajectory, FolderAndRos2BagsGiveTheSameTrajectory) {
   const Written& w = WriteAll();
   lio::OdometryConfig config =
-      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+      lio::LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   config.gravity = SimFolderReader(w.folder.string()).Gravity().value();
   for (const auto method : {lio::LioMethod::kSingerLio, lio::LioMethod::kImuInput}) {
     config.method = method;

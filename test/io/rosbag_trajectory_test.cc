@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "ctlio/io/newer_college.h"
 #include "ctlio/io/rosbag_source.h"
 #include "ctlio/io/sim_folder.h"
@@ -60,7 +61,7 @@ TEST(RosbagTrajectory, FolderAndBagGiveTheSameTrajectory) {
     EXPECT_GE(n, 7u);
   }
   lio::OdometryConfig config =
-      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+      lio::LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   // A bag carries no gravity magnitude: give the config the folder's (the simulator's) value.
   config.gravity = folder.Gravity().value();
   for (const auto method : {lio::LioMethod::kSingerLio, lio::LioMethod::kImuInput}) {
@@ -135,7 +136,7 @@ TEST(RosbagTrajectory, UnusableScansInABagDoNotAbortTheRun) {
     WriteRosbag(source, (d / "run.bag").string());
   }
   lio::OdometryConfig config =
-      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+      lio::LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   config.gravity = sim::SimulatedSource(c).Gravity().value();
   RosbagSource bag((d / "run.bag").string());
   const lioapp::RunSummary s = lioapp::RunOdometry(bag, config);

@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "ctlio/io/bag_sensor_suggestion.h"
 #include "ctlio/io/bag_writer.h"
 #include "ctlio/io/livox_custom_msg.h"
@@ -223,7 +224,7 @@ TEST(SensorBags, EachRecordingSuggestsItsOwnConfig) {
       ASSERT_TRUE(s.has_value()) << bag;
       EXPECT_EQ(s->sensor, m.name) << s->evidence;
       EXPECT_EQ(s->config, "data/sensors/" + m.name + ".yaml");
-      EXPECT_TRUE(fs::is_regular_file(fs::path(CTLIO_SOURCE_DIR) / s->config));
+      EXPECT_TRUE(fs::is_regular_file(fs::path(ctlio::testing::SourceDir()) / s->config));
       EXPECT_EQ(s->note.empty(), m.driver.accel_unit == 1.0);  // Livox: the g advice
     }
   }

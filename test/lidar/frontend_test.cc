@@ -12,6 +12,7 @@
 #include <set>
 #include <tuple>
 
+#include "common/test_paths.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
 
 namespace ctlio::lio {
@@ -409,7 +410,7 @@ TEST(Frontend, PreprocessUsesFineVoxelsForInitialScans) {
 
 TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   const auto o =
-      LoadLidarFrontendOptions(std::string(CTLIO_SOURCE_DIR) + "/data/lidar_frontend.yaml");
+      LoadLidarFrontendOptions(ctlio::testing::SourceDir() + "/data/lidar_frontend.yaml");
   const LidarFrontendOptions d;
   EXPECT_EQ(o.min_range, d.min_range);
   EXPECT_EQ(o.max_range, d.max_range);

@@ -13,6 +13,7 @@
 
 #include "common/gradient_check.h"
 #include "common/singer_model.h"
+#include "common/test_paths.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/factors/gp/shared_knot_interval.h"
 #include "ctlio/factors/lidar/continuous_point_to_plane.h"
@@ -26,7 +27,7 @@ namespace ctlio::lio {
 namespace {
 
 const std::string kFolder =
-    std::string(CTLIO_SHARED_DATA_DIR) + "/gtsam_points_lidar_samples/newer_college_2020_06";
+    ctlio::testing::SharedDataDir() + "/gtsam_points_lidar_samples/newer_college_2020_06";
 
 // A synthetic outdoor-like sweep: ground plane, walls and clutter within 40 m.
 std::vector<Vec3> SyntheticSweep(int n, uint32_t seed) {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "common/singer_model.h"
+#include "common/test_paths.h"
 #include "ctlio/factors/gp/interpolator.h"
 #include "ctlio/io/point_cloud_io.h"
 #include "ctlio/solvers/lio/frontend.h"
@@ -30,7 +31,7 @@ namespace ctlio::lio {
 namespace {
 
 const std::string kFolder =
-    std::string(CTLIO_SHARED_DATA_DIR) + "/gtsam_points_lidar_samples/newer_college_2020_06";
+    ctlio::testing::SharedDataDir() + "/gtsam_points_lidar_samples/newer_college_2020_06";
 
 double Median(std::vector<double> v) {
   const size_t mid = v.size() / 2;
@@ -71,7 +72,7 @@ SweepResult RegisterSweep(const std::string& id) {
   // The shipped defaults (data/lidar_frontend.yaml, SPEC §4). This is the front end's first
   // scan, so the sweep is subsampled at initial_voxel_size (0.2 m), then one keypoint per 1 m.
   const LidarFrontendOptions options =
-      LoadLidarFrontendOptions(std::string(CTLIO_SOURCE_DIR) + "/data/lidar_frontend.yaml");
+      LoadLidarFrontendOptions(ctlio::testing::SourceDir() + "/data/lidar_frontend.yaml");
   LidarFrontend frontend(options);
   std::vector<Vec3> map_points;
   for (const Vec3& p : deskewed.points) map_points.push_back(p);

@@ -21,6 +21,7 @@
 
 #include "common/sim_lio.h"
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
@@ -253,7 +254,7 @@ TEST(CalibrationOutput, TheOverlayKeepsAnOffsetFlaggedOnAFifthOfTheScans) {
   sigma << 0.005, 0.005, 0.005, 0.05 * kDeg, 0.17 * kDeg, 0.05 * kDeg;
   const RunSummary run =
       ConstructedRun(101, {20, 0, 0, 0, 0, 0, 0}, 0.0, Start(), Estimate(), 5.2e-4, sigma);
-  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const std::string data = ctlio::testing::SourceDir() + "/data/";
   const lio::OdometryConfig overlay =
       lio::LoadOdometryConfig(data + "sim_lio.yaml," + data + "calibration.yaml");
   for (const lio::LioMethod m : {lio::LioMethod::kSingerLio, lio::LioMethod::kImuInput}) {
@@ -290,7 +291,7 @@ TEST(CalibrationOutput, TheOverlaysDriftCheckSeparatesASixtySecondRunsMovements)
     }
     return run;
   };
-  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const std::string data = ctlio::testing::SourceDir() + "/data/";
   const lio::CalibrationOptions overlay =
       lio::LoadOdometryConfig(data + "sim_lio.yaml," + data + "calibration.yaml").calibration;
   EXPECT_TRUE(RecommendCalibration(moving(2.6), overlay)->kept_at_start.empty());

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/test_paths.h"
 #include "common/write_temp.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
@@ -82,7 +83,7 @@ TEST(OdometryConfigComposition, ErrorsNameTheFileAndLine) {
 // data/calibration.yaml has no `base:` and works on top of every shipped config: its keys set,
 // every other key the config's own (the extrinsic and the IMU noise of the data).
 TEST(OdometryConfigComposition, CalibrationOverlayWorksOnEveryShippedConfig) {
-  const std::string dir = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const std::string dir = ctlio::testing::SourceDir() + "/data/";
   EXPECT_FALSE(YAML::LoadFile(dir + "calibration.yaml")["base"].IsDefined());
   for (const std::string name : {"sim_lio.yaml", "newer_college_lio.yaml"}) {
     SCOPED_TRACE(name);

@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "common/test_paths.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lio {
@@ -19,7 +20,7 @@ using ::testing::IsEmpty;
 TEST(ConfigPlausibility, TheDefaultsAndTheShippedConfigsArePlausible) {
   EXPECT_THAT(ImplausibleSettings(OdometryConfig{}), IsEmpty());
   for (const char* name : {"sim_lio.yaml", "newer_college_lio.yaml", "sim_lio_calibration.yaml"}) {
-    const std::string path = std::string(CTLIO_SOURCE_DIR) + "/data/" + name;
+    const std::string path = ctlio::testing::SourceDir() + "/data/" + name;
     const OdometryConfig base = LoadOdometryConfig(path);
     for (LioMethod m : {LioMethod::kSingerLio, LioMethod::kImuInput, LioMethod::kLidarGyro}) {
       EXPECT_THAT(ImplausibleSettings(base.ForMethod(m)), IsEmpty()) << name;

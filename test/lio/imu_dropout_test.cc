@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/sim_lio.h"
+#include "common/test_paths.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/sim/sensor_models.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
@@ -215,7 +216,7 @@ TEST(ImuDropout, LidarOnlyStartsAgainFromThePredictionAfterADivergedScan) {
                                              sim::WorldKind::kPark);
   sim::ApplySensorModel(sim::FindSensorModel("vlp16"), &seq);
   seq.duration_s = 1.5;
-  OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml")
+  OdometryConfig c = LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sensors/vlp16.yaml")
                          .ForMethod(LioMethod::kLidarOnly);
   c.frontend.line_neighbourhood_ratio = 0.0;
   sim::SimulatedSource source(seq);

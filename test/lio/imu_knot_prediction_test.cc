@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/sim_gp_state.h"
+#include "common/test_paths.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 #include "lio/run_odometry.h"
@@ -126,7 +127,7 @@ TEST(ImuKnotPrediction, WithoutAnAccelerometerTheLinearVelocityIsHeld) {
 // it is under 1 cm.
 TEST(ImuKnotPrediction, TheOdometryFollowsTheMotionStart) {
   OdometryConfig config =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml");
+      LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio_calibration.yaml");
   config.calibration = CalibrationOptions();
   ASSERT_TRUE(config.imu_prediction);  // the calibration configuration starts from the IMU
   sim::SimConfig sequence = sim::ExperimentConfig(sim::Regime::kMedium, 100);

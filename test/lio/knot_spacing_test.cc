@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/sim_lio.h"
+#include "common/test_paths.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 #include "ctlio/solvers/lio/odometry_config.h"
@@ -166,7 +167,7 @@ TEST(KnotSpacing, YamlKeysAndTheShippedDefaults) {
   EXPECT_EQ(o.accel_curvature, 1.5);
   EXPECT_EQ(o.accel_variance_floor, 0.3);
   EXPECT_EQ(o.gyro_variance_floor, 0.001);
-  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const std::string data = ctlio::testing::SourceDir() + "/data/";
   for (const char* sensor : {"vlp16", "hdl32e", "os1_64", "mid360"}) {
     const OdometryConfig c = LoadOdometryConfig(data + "sensors/" + sensor + ".yaml");
     EXPECT_TRUE(c.adaptive_knots.enabled(c.knots_per_scan)) << sensor;

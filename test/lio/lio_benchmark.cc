@@ -5,6 +5,7 @@
 // repetitions) and the app's own p95/peak memory (ctlio_odometry's evaluation.txt).
 #include <benchmark/benchmark.h>
 
+#include "common/test_paths.h"
 #include "ctlio/sim/lidar_inertial_sim.h"
 #include "ctlio/solvers/lio/lio_odometry.h"
 
@@ -19,7 +20,7 @@ void RunScans(benchmark::State& state, lio::LioMethod method, int beams, int dec
   c.lidar.firing_decimation = decimation;
   sim::SimulatedSource source(c);
   lio::OdometryConfig config =
-      lio::LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+      lio::LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   config.method = method;
   auto odometry = lio::MakeLioOdometry(config);
   std::vector<io::ScanFrame> frames;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/test_paths.h"
 #include "common/write_temp.h"
 #include "ctlio/solvers/lio/config_composition.h"
 
@@ -75,8 +76,7 @@ TEST(OdometryConfig, BaselineInterpolationAndSubstepsAreReadAndChecked) {
 }
 
 TEST(OdometryConfig, ShippedConfigsLoad) {
-  const OdometryConfig sim =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const OdometryConfig sim = LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   EXPECT_EQ(sim.method, LioMethod::kSingerLio);
   EXPECT_TRUE(sim.exact_specific_force);
   EXPECT_FALSE(sim.overlap_stages);  // one thread unless asked
@@ -85,7 +85,7 @@ TEST(OdometryConfig, ShippedConfigsLoad) {
   EXPECT_THROW(LoadOdometryConfig(WriteTemp("overlap_bad.yaml", "window:\n  overlap: 2x\n")),
                std::runtime_error);
   const OdometryConfig nc =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
+      LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/newer_college_lio.yaml");
   // SPEC §4: the paper's Newer College values where the file keeps them.
   EXPECT_DOUBLE_EQ(nc.qc[0], 5000);
   EXPECT_DOUBLE_EQ(nc.qc[3], 500);
@@ -275,8 +275,7 @@ TEST(OdometryConfig, ImuPrediction) {
 
 TEST(OdometryConfig, CalibrationSection) {
   // Off by default (and in the shipped configs).
-  const OdometryConfig sim =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const OdometryConfig sim = LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   EXPECT_FALSE(sim.calibration.any());
   const OdometryConfig c = LoadOdometryConfig(
       WriteTemp("cal.yaml",
@@ -390,10 +389,9 @@ TEST(OdometryConfig, CalibrationSection) {
 // data/sim_lio_calibration.yaml extends data/sim_lio.yaml (`base:`): its own keys, and the base's
 // everywhere else, the per-method overrides included.
 TEST(OdometryConfig, CalibrationConfigExtendsTheSimConfig) {
-  const OdometryConfig sim =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const OdometryConfig sim = LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   const OdometryConfig cal =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio_calibration.yaml");
+      LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio_calibration.yaml");
   EXPECT_EQ(cal.knots_per_scan, 2);
   EXPECT_TRUE(cal.imu_prediction);
   EXPECT_FALSE(sim.imu_prediction);

@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "common/test_paths.h"
 #include "common/write_temp.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
@@ -110,7 +111,7 @@ TEST(PerMethodConfig, PoseCovarianceLidarScaleIsPerMethodAndPositive) {
 // The lidar floor of the pose covariance: per method (data/sim_lio.yaml sets it for the
 // baseline only); it and the map's σ negative, absurd or NaN: an error naming the key.
 TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
-  const OdometryConfig c = LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sim_lio.yaml");
+  const OdometryConfig c = LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sim_lio.yaml");
   EXPECT_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_lidar_floor_m, 0.0);
   EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_m, 0.002);
   EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).pose_covariance_lidar_floor_rad, 0.0002);
@@ -119,7 +120,7 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   // baseline's on the Newer College-like preset (data/newer_college_lio.yaml).
   EXPECT_EQ(c.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 0.0);
   const OdometryConfig v =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/sensors/vlp16.yaml");
+      LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sensors/vlp16.yaml");
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.001);
   EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
@@ -133,7 +134,7 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.1);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.001);
   const OdometryConfig nc =
-      LoadOdometryConfig(std::string(CTLIO_SOURCE_DIR) + "/data/newer_college_lio.yaml");
+      LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/newer_college_lio.yaml");
   EXPECT_DOUBLE_EQ(nc.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 1.0);
   EXPECT_EQ(nc.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 0.0);
   for (const char* key : {"pose_covariance_lidar_floor_m", "pose_covariance_lidar_floor_rad",

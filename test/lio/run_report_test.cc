@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/temp_dir.h"
+#include "common/test_paths.h"
 #include "lio/config_origin.h"
 #include "lio/output_files.h"
 #include "lio/progress.h"
@@ -127,7 +128,7 @@ TEST(ConfigOrigin, NamesEveryFileOfTheComposition) {
   // A config that does not load (its error is the loader's to report): as given.
   EXPECT_EQ(DescribeConfig(dir + "/bad.yaml"), dir + "/bad.yaml");
   // The repository's calibration config: the simulator config and the calibration overlay.
-  const std::string data = std::string(CTLIO_SOURCE_DIR) + "/data/";
+  const std::string data = ctlio::testing::SourceDir() + "/data/";
   EXPECT_EQ(DescribeConfig(data + "sim_lio_calibration.yaml"),
             data + "sim_lio.yaml (base of " + data + "sim_lio_calibration.yaml), " + data +
                 "calibration.yaml (base of " + data + "sim_lio_calibration.yaml), " + data +

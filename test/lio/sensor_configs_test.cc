@@ -8,13 +8,14 @@
 
 #include <filesystem>
 
+#include "common/test_paths.h"
 #include "ctlio/sim/sensor_models.h"
 #include "ctlio/solvers/lio/odometry_config.h"
 
 namespace ctlio::lio {
 namespace {
 
-const std::string kDir = std::string(CTLIO_SOURCE_DIR) + "/data/sensors/";
+const std::string kDir = ctlio::testing::SourceDir() + "/data/sensors/";
 
 TEST(SensorConfigs, OnePerModelWithItsImuAndExtrinsic) {
   EXPECT_FALSE(LoadOdometryYaml(kDir + "base.yaml")["extrinsic"].IsDefined());
