@@ -20,6 +20,7 @@
 #include "ctlio/solvers/lio/continuous_lidar_term.h"
 #include "ctlio/solvers/lio/imu_knot_prediction.h"
 #include "ctlio/solvers/lio/knot_spacing.h"
+#include "ctlio/solvers/lio/sweep_keypoint_budget.h"
 
 namespace ctlio::lio {
 
@@ -258,12 +259,15 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
   const double t_prev = knots_.back().t;
   const int K = KnotsForScan(t_prev, scan.t_end);
   split_sweep_ = K > config_.knots_per_scan;
-  // A split sweep's own keypoint budget (knot_spacing.h): chosen from the same preprocessed
-  // points with the front end's rule, so only the cap differs.
-  const int split_cap = config_.adaptive_knots.max_keypoints;
-  use_split_keypoints_ = split_sweep_ && split_cap > 0;
-  if (use_split_keypoints_) {
-    split_keypoints_ = KeypointsOf(scan.points, config_.frontend.keypoint_voxel_size, split_cap);
+  // The sweep's own keypoint budget when it has one (a split sweep, or a slow one:
+  // sweep_keypoint_budget.h), judged on the newest knot's solved speed at the sweep's start;
+  // chosen from the same preprocessed points with the front end's rule, so only the cap differs.
+  const double speed = Eigen::Map<const Vec6>(knots_.back().velocity).head<3>().norm();
+  const int cap =
+      SweepKeypointCap(config_.adaptive_knots, config_.slow_sweep_keypoints, split_sweep_, speed);
+  use_own_keypoints_ = cap > 0;
+  if (use_own_keypoints_) {
+    own_keypoints_ = KeypointsOf(scan.points, config_.frontend.keypoint_voxel_size, cap);
   }
   for (int i = 1; i <= K; ++i) {
     const double t = i == K ? scan.t_end : t_prev + (scan.t_end - t_prev) * i / K;
@@ -382,8 +386,7 @@ std::unique_ptr<LidarTerm> GpKnotEstimator::MakeLidarTerm(const PreparedScan& sc
   for (size_t i = ScanStartIndex(); i < knots_.size(); ++i) {
     knots.push_back({knots_[i].t, knots_[i].keys});
   }
-  const std::vector<TimedPoint>& keypoints =
-      use_split_keypoints_ ? split_keypoints_ : scan.keypoints;
+  const std::vector<TimedPoint>& keypoints = use_own_keypoints_ ? own_keypoints_ : scan.keypoints;
   auto term = estimates_extrinsic()
                   ? std::make_unique<ContinuousLidarTerm>(model_, knots, keypoints,
                                                           scan.T_robot_lidar, window)

@@ -219,7 +219,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   without_imu_.Begin(ScanWithoutImu::Applies(config_.method, *result), estimator_->NewestKeys(),
                      window_);
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
-  result->keypoints = static_cast<int>(lidar->num_keypoints());  // a split sweep's own budget
+  result->keypoints = static_cast<int>(lidar->num_keypoints());  // a sweep's own budget
   calibration_.Hold(scan.t_end, &window_, result);
   const RegistrationSummary registered = without_imu_.Register(
       config_.frontend, registration_, frontend_.map(), lidar.get(), &window_);

@@ -83,6 +83,7 @@ void OdometryConfig::Validate() const {
   require(adaptive_knots.max_keypoints >= 0 && adaptive_knots.max_keypoints <= 1000000,
           "window.adaptive_knots_max_keypoints must be in [0, 1000000] (0: "
           "lidar_frontend.max_keypoints)");
+  slow_sweep_keypoints.Validate();
   require(imus.size() <= 5, "imus: at most 5 IMUs (the bias keys of a knot)");
   for (const ImuSensor& s : imus) {
     require(s.accel_variance >= 0 && s.gyro_variance >= 0, "imus[].variances must be >= 0");

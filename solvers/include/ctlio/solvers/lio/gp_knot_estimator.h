@@ -136,10 +136,11 @@ class GpKnotEstimator final : public Estimator {
   int64_t next_knot_ = 0;
   int scan_knots_ = 0;        // knots the last AddState added (0 after Initialise)
   bool split_sweep_ = false;  // the last AddState's sweep got more knots than knots_per_scan
-  // A split sweep's keypoints under window.adaptive_knots_max_keypoints (the lidar term holds a
-  // reference to them until the next AddState); used when use_split_keypoints_.
-  std::vector<TimedPoint> split_keypoints_;
-  bool use_split_keypoints_ = false;
+  // The sweep's keypoints under its own budget (window.adaptive_knots_max_keypoints on a split
+  // sweep, window.slow_sweep_max_keypoints on a slow one; sweep_keypoint_budget.h). The lidar
+  // term holds a reference to them until the next AddState; used when use_own_keypoints_.
+  std::vector<TimedPoint> own_keypoints_;
+  bool use_own_keypoints_ = false;
   bool time_offsets_ = false;
   std::vector<double> last_stamp_;         // per IMU: the newest stamp [s] already a measurement
   const SlidingWindow* window_ = nullptr;  // for Report (the offsets' blocks)

@@ -22,6 +22,7 @@
 #include "ctlio/solvers/lio/input_check_options.h"
 #include "ctlio/solvers/lio/knot_spacing.h"
 #include "ctlio/solvers/lio/lidar_frontend_options.h"
+#include "ctlio/solvers/lio/sweep_keypoint_budget.h"
 
 namespace YAML {
 class Node;
@@ -144,6 +145,10 @@ struct OdometryConfig {
   // window.adaptive_knots_accel_variance, _gyro_variance: the IMU variances' floor on the sweeps
   // the rule splits (AdaptiveKnotOptions).
   AdaptiveKnotOptions adaptive_knots;
+  // window.slow_sweep_max_keypoints, window.slow_sweep_speed [m/s] (the GP methods;
+  // sweep_keypoint_budget.h): an unsplit sweep whose estimated speed is below the threshold gets
+  // its own keypoint budget (walking against driving). Off by default in code (0).
+  SlowSweepKeypoints slow_sweep_keypoints;
   // window.threads: the solve's interpolations and lidar rows (SlidingWindowOptions::threads);
   // Ceres evaluates on one thread (iterations per round: lidar_frontend.solver_iterations)
   int solver_threads = 1;
