@@ -62,6 +62,10 @@ std::string ReferenceRanOff(const ReferenceDisagreement& d, const ReferenceTrust
   return text;
 }
 
+FrameConsistencyCheck ImuFrameCheck(const lio::OdometryConfig& config) {
+  return FrameConsistencyCheck(config.ImuPose(0), 0, {}, config.calibration.TimeOffset(0));
+}
+
 namespace {
 lio::OdometryConfig ReferenceConfig(lio::OdometryConfig c) {
   c.method = lio::LioMethod::kLidarGyro;
@@ -74,7 +78,7 @@ lio::OdometryConfig ReferenceConfig(lio::OdometryConfig c) {
 
 AccelReference::AccelReference(const lio::OdometryConfig& config, size_t max_scans)
     : odometry_(std::make_unique<lio::LioOdometry>(ReferenceConfig(config))),
-      frames_(config.ImuPose(0), 0, {}, config.calibration.TimeOffset(0)),
+      frames_(ImuFrameCheck(config)),
       max_scans_(max_scans) {}
 
 AccelReference::~AccelReference() = default;

@@ -27,6 +27,11 @@
 
 namespace ctlio::lioapp {
 
+// The frame check of IMU 0 as the estimator sees it: its configured pose and clock offset (the
+// samples placed at t + δ, as the estimator places them). Every check of a run's IMU frame is
+// made here, so none judges the raw stamps of a configured offset.
+FrameConsistencyCheck ImuFrameCheck(const lio::OdometryConfig& config);
+
 struct RelabellingOptions {
   // Measured over 80-scan references (8 s; docs/user-guide/bad-input.md): clean runs, tuning
   // index 100 and unseen 320/310 in the box, office, quad and town with five sensors, gain

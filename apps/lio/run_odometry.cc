@@ -255,7 +255,7 @@ RunSummary RunOdometry(io::DataSource& source, lio::OdometryConfig config,
   std::vector<int64_t> scan_ends;  // of the scans handed to the odometry, for the lidar gaps
   std::optional<std::pair<std::chrono::steady_clock::time_point, int64_t>> pace_origin;
   // The IMU's frame against the lidar trajectory's (frame_consistency.h); lidar_only uses no IMU.
-  FrameConsistencyCheck frames(config.ImuPose(0), 0, {}, config.calibration.TimeOffset(0));
+  FrameConsistencyCheck frames = ImuFrameCheck(config);
   const bool check_frames = config.method != lio::LioMethod::kLidarOnly;
   // lidar_gyro's own poses already leave the accelerometer out: its frame fit is the reference.
   std::optional<AccelReference> reference;
