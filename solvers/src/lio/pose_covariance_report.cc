@@ -46,11 +46,12 @@ std::optional<Mat6> WithMisfitAndMapError(const OdometryConfig& config, const Ma
                                         estimator.NewestPoseTangentFromBody());
       };
       const std::optional<Mat6> d_accel = increase(motion, f_accel);
-      const std::optional<Mat6> d_gyro = increase(imu.gyro.empty() ? motion : imu.gyro, f_gyro);
-      if (!d_accel || !d_gyro) return std::nullopt;
+      if (!d_accel) return std::nullopt;
       if (gyro.dof == 0) {
         relative += *d_accel;
       } else {
+        const std::optional<Mat6> d_gyro = increase(imu.gyro.empty() ? motion : imu.gyro, f_gyro);
+        if (!d_gyro) return std::nullopt;
         relative.topLeftCorner<3, 3>() += d_accel->topLeftCorner<3, 3>();
         relative.bottomRightCorner<3, 3>() += d_gyro->bottomRightCorner<3, 3>();
       }
