@@ -194,6 +194,7 @@ void SlidingWindow::RemoveResidualBlock(ceres::ResidualBlockId id) {
   for (StateId s : it->second) states_.at(s).residuals.erase(id);
   residuals_.erase(it);
   residual_serial_.erase(id);
+  marginal_priors_.erase(id);
   problem_->RemoveResidualBlock(id);
 }
 
@@ -280,25 +281,89 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
     }
   }
   std::unique_ptr<MarginalizationPrior> prior;
-  if (report.prior_rank > 0) {
-    std::vector<const ceres::Manifold*> manifolds;
-    std::vector<int> sizes;
-    std::vector<const double*> points;
-    for (StateId id : report.kept) {
-      const StateBlock& block = states_.at(id);
-      manifolds.push_back(block.manifold.get());
-      sizes.push_back(block.ambient_size);
-      points.push_back(block.values.get());
-    }
-    prior = std::make_unique<MarginalizationPrior>(manifolds, sizes, points, sqrt_information, r0);
-  }
+  if (report.prior_rank > 0) prior = MakePrior(report.kept, sqrt_information, r0);
 
   for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
   for (StateId id : leaving) {
     problem_->RemoveParameterBlock(states_.at(id).values.get());
     states_.erase(id);
   }
-  if (prior != nullptr) report.prior = AddResidualBlock(prior.release(), nullptr, report.kept);
+  if (prior != nullptr) {
+    report.prior = AddResidualBlock(prior.release(), nullptr, report.kept);
+    marginal_priors_.insert(report.prior);
+  }
+  return report;
+}
+
+std::unique_ptr<MarginalizationPrior> SlidingWindow::MakePrior(
+    const std::vector<StateId>& kept, const Eigen::MatrixXd& sqrt_information,
+    const Eigen::VectorXd& r0) const {
+  std::vector<const ceres::Manifold*> manifolds;
+  std::vector<int> sizes;
+  std::vector<const double*> points;
+  for (StateId id : kept) {
+    const StateBlock& block = states_.at(id);
+    manifolds.push_back(block.manifold.get());
+    sizes.push_back(block.ambient_size);
+    points.push_back(block.values.get());
+  }
+  return std::make_unique<MarginalizationPrior>(manifolds, sizes, points, sqrt_information, r0);
+}
+
+MarginalizationReport SlidingWindow::ForgetInformation(const std::vector<StateId>& ids) {
+  if (ids.empty()) Throw(__LINE__, "ForgetInformation() needs at least one state id");
+  std::set<StateId> forgotten;
+  for (StateId id : ids) {
+    Get(id, __LINE__);
+    if (!forgotten.insert(id).second) Throw(__LINE__, "state id " + std::to_string(id) + " twice");
+  }
+  // The marginal priors on those states; live residual blocks are re-linearised at every solve
+  // and keep what they say.
+  std::set<ceres::ResidualBlockId> prior_set;
+  for (StateId id : forgotten) {
+    for (ceres::ResidualBlockId r : states_.at(id).residuals) {
+      if (marginal_priors_.count(r)) prior_set.insert(r);
+    }
+  }
+  MarginalizationReport report;
+  if (prior_set.empty()) return report;
+  std::set<StateId> touched, kept;
+  for (ceres::ResidualBlockId r : prior_set) {
+    for (StateId s : residuals_.at(r)) (forgotten.count(s) ? touched : kept).insert(s);
+  }
+  report.marginalized.assign(touched.begin(), touched.end());
+  report.kept.assign(kept.begin(), kept.end());
+  report.removed_residual_blocks = static_cast<int>(prior_set.size());
+  for (StateId id : touched) report.marginalized_dimension += states_.at(id).tangent_size;
+  std::vector<ceres::ResidualBlockId> priors(prior_set.begin(), prior_set.end());
+  std::sort(priors.begin(), priors.end(),
+            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
+              return residual_serial_.at(a) < residual_serial_.at(b);
+            });
+  // The priors' joint Gaussian, linearised at the current estimate as Marginalize linearises an
+  // older prior, integrated over the forgotten states: the Schur complement onto the others
+  // is their marginal, so they keep exactly what the priors said about them.
+  Eigen::MatrixXd sqrt_information;
+  Eigen::VectorXd r0;
+  std::vector<StateId> ordering(report.marginalized);
+  ordering.insert(ordering.end(), report.kept.begin(), report.kept.end());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  Linearize(priors, ordering, &H, &b);
+  const SchurComplementResult schur = SchurComplementLeading(
+      H, b, report.marginalized_dimension, options_.relative_eigenvalue_threshold);
+  report.marginalized_rank = schur.marginalized_rank;
+  if (!kept.empty()) {
+    report.prior_rank = InformationSquareRoot(schur.information, schur.vector, &sqrt_information,
+                                              &r0, options_.relative_eigenvalue_threshold);
+  }
+  std::unique_ptr<MarginalizationPrior> prior;
+  if (report.prior_rank > 0) prior = MakePrior(report.kept, sqrt_information, r0);
+  for (ceres::ResidualBlockId r : priors) RemoveResidualBlock(r);
+  if (prior != nullptr) {
+    report.prior = AddResidualBlock(prior.release(), nullptr, report.kept);
+    marginal_priors_.insert(report.prior);
+  }
   return report;
 }
 

@@ -1,6 +1,7 @@
 // The warm-up replay's driver on its own (calibrating_odometry.h): the replay's start config, the
 // frozen report, the forwarding to the single-pass pipeline, the swap at the span and the giving
-// up after twice the span. The replay's effect on the calibration: warmup_replay_test.cc.
+// up after twice the span; and its alternative, forgetting the warm-up's calibration information
+// at the span. The replay's effect on the calibration: warmup_replay_test.cc.
 #include "ctlio/solvers/lio/calibrating_odometry.h"
 
 #include <gtest/gtest.h>
@@ -225,6 +226,81 @@ TEST(CalibratingOdometry, GivesUpAfterTwiceTheSpanWithoutAnEstimate) {
   }
   EXPECT_TRUE(driver.warmup_results().empty());
   EXPECT_EQ(driver.config().calibration.warmup_replay_s, 0.22);  // the live pipeline carries on
+}
+
+// calibration.warmup_forget_s: at the first estimated scan ending 0.5 s after the first began,
+// the marginal prior forgets the calibration (once, with a note); until then the run is the run
+// without it bit for bit, and after it the calibration's σ is larger (the warm-up's information
+// is gone) while the pose covariance still reads the window's (new) marginal prior.
+TEST(CalibratingOdometry, ForgetsTheWarmupsCalibrationInformationOnceAtTheSpan) {
+  OdometryConfig config = Calibrating(0.0);
+  config.kept_results = 0;
+  config.pose_covariance = true;
+  OdometryConfig forgetting = config;
+  forgetting.calibration.warmup_forget_s = 0.5;
+  EXPECT_THROW(LioOdometry{forgetting}, std::invalid_argument);  // the driver's option
+  OdometryConfig both = forgetting;
+  both.calibration.warmup_replay_s = 1.0;
+  EXPECT_THROW(both.Validate(), std::invalid_argument);
+  OdometryConfig negative = config;
+  negative.calibration.warmup_forget_s = -1.0;
+  EXPECT_THROW(negative.Validate(), std::invalid_argument);
+
+  CalibratingOdometry plain(config), driver(forgetting);
+  const std::vector<ScanResult> a = Feed(WrongStart(), &plain);
+  const std::vector<ScanResult> b = Feed(WrongStart(), &driver);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GE(b.size(), 9u);
+  int forgot_at = -1, notes = 0;
+  for (size_t i = 0; i < b.size(); ++i) {
+    if (b[i].message.find("calibration warm-up forgotten") != std::string::npos) {
+      forgot_at = static_cast<int>(i);
+      ++notes;
+    }
+  }
+  ASSERT_EQ(notes, 1);
+  // 0.1 s sweeps from the first scan's begin: the fifth scan ends at 0.5 s, or a hair before it
+  // (the sweep's last firing), and then the sixth.
+  EXPECT_GE(forgot_at, 4);
+  EXPECT_LE(forgot_at, 5);
+  EXPECT_NE(driver.results()[static_cast<size_t>(forgot_at)].message.find("forgotten"),
+            std::string::npos);
+  for (int i = 0; i <= forgot_at; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    EXPECT_EQ(a[k].T_mr.Matrix(), b[k].T_mr.Matrix()) << i;
+    EXPECT_EQ(a[k].calibration.time_offset_s, b[k].calibration.time_offset_s) << i;
+  }
+  const size_t next = static_cast<size_t>(forgot_at) + 1;
+  ASSERT_EQ(b[next].calibration.time_offset_sigma_s.size(), 1u);
+  EXPECT_GT(b[next].calibration.time_offset_sigma_s[0], a[next].calibration.time_offset_sigma_s[0]);
+  EXPECT_GT(b[next].calibration.extrinsic_sigma.head<3>().norm(),
+            a[next].calibration.extrinsic_sigma.head<3>().norm());
+  for (size_t i = next; i < b.size(); ++i) {
+    ASSERT_NE(b[i].status, ScanStatus::kFailed) << i << ": " << b[i].message;
+    EXPECT_TRUE(b[i].has_pose_covariance) << i;
+    EXPECT_TRUE(b[i].pose_covariance.allFinite()) << i;
+  }
+  // With the map restarted from the forgetting scan: said in the note, and the run goes on.
+  OdometryConfig restarting = forgetting;
+  restarting.calibration.warmup_forget_restart_map = true;
+  CalibratingOdometry restarted(restarting);
+  const std::vector<ScanResult> c = Feed(WrongStart(), &restarted);
+  ASSERT_EQ(c.size(), b.size());
+  EXPECT_NE(c[static_cast<size_t>(forgot_at)].message.find("the map restarted"), std::string::npos);
+  for (size_t i = next; i < c.size(); ++i) {
+    ASSERT_NE(c[i].status, ScanStatus::kFailed) << i << ": " << c[i].message;
+  }
+  OdometryConfig restart_alone = config;
+  restart_alone.calibration.warmup_forget_restart_map = true;
+  EXPECT_THROW(restart_alone.Validate(), std::invalid_argument);
+  // Nothing to calibrate: nothing forgotten.
+  OdometryConfig known = forgetting;
+  known.calibration.estimate_time_offset = false;
+  known.calibration.estimate_extrinsic = false;
+  CalibratingOdometry uncalibrated(known);
+  for (const ScanResult& r : Feed(WrongStart(), &uncalibrated)) {
+    EXPECT_EQ(r.message.find("forgotten"), std::string::npos) << r.message;
+  }
 }
 
 }  // namespace

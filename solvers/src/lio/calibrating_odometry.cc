@@ -30,6 +30,8 @@ OdometryConfig SinglePass(OdometryConfig config) {
   cal.warmup_replay_passes = 1;
   cal.warmup_replay_hold = false;
   cal.warmup_replay_freeze = false;
+  cal.warmup_forget_s = 0.0;
+  cal.warmup_forget_restart_map = false;
   return config;
 }
 
@@ -83,7 +85,8 @@ CalibratingOdometry::CalibratingOdometry(const OdometryConfig& config, ReplaySch
     : config_(Validated(config)),
       schedule_(schedule),
       pipeline_(internal::MakeReplayPipeline(SinglePass(config), 0.0)),
-      keeping_(config.calibration.replays_warmup()) {
+      keeping_(config.calibration.replays_warmup()),
+      forgetting_(config.calibration.forgets_warmup()) {
   if (!(schedule_.adopt_after_s >= 0.0)) {
     throw std::invalid_argument("CalibratingOdometry: ReplaySchedule::adopt_after_s must be >= 0");
   }
@@ -117,6 +120,7 @@ ScanResult CalibratingOdometry::AddScan(const LidarScan& scan) {
   // it is adopted.
   Record(result, !keeping_ && !background_);
   if (keeping_) MaybeReplay(&result);
+  if (forgetting_) MaybeForget(scan, &result);
   if (background_ && scan.end_ns >= adopt_ns_) AdoptBackground(&result);
   return result;
 }
@@ -150,6 +154,27 @@ void CalibratingOdometry::MaybeReplay(ScanResult* result) {
                       " s (calibration.warmup_replay_s)");
   warmup_scans_ = {};
   warmup_imu_ = {};
+}
+
+void CalibratingOdometry::MaybeForget(const LidarScan& scan, ScanResult* result) {
+  if (first_begin_ns_ < 0) first_begin_ns_ = scan.begin_ns;
+  const double span = 1e-9 * static_cast<double>(scan.end_ns - first_begin_ns_);
+  if (span < config_.calibration.warmup_forget_s || !pipeline_->initialised() ||
+      result->status == ScanStatus::kFailed) {
+    return;
+  }
+  forgetting_ = false;
+  const MarginalizationReport forgot = pipeline_->ForgetCalibrationInformation();
+  std::ostringstream note;
+  note << "calibration warm-up forgotten after " << span << " s: " << forgot.removed_residual_blocks
+       << " marginal prior(s) replaced by their marginal over the " << forgot.kept.size()
+       << " other states (calibration.warmup_forget_s)";
+  if (config_.calibration.warmup_forget_restart_map) {
+    pipeline_->RestartMap();
+    note << "; the map restarted from this scan";
+  }
+  AddNote(result, note.str());
+  results_.back().message = result->message;
 }
 
 void CalibratingOdometry::Replay(double span, ScanResult* result) {

@@ -34,6 +34,13 @@ void CalibrationOptions::Validate() const {
   // Beyond a minute the kept raw scans (≈ 7 MB per full-resolution 128-beam sweep) dominate.
   require(std::isfinite(warmup_replay_s) && warmup_replay_s >= 0 && warmup_replay_s <= 60,
           "calibration.warmup_replay_s must be in [0, 60] s (0: no replay)");
+  require(std::isfinite(warmup_forget_s) && warmup_forget_s >= 0 && warmup_forget_s <= 3600,
+          "calibration.warmup_forget_s must be in [0, 3600] s (0: off)");
+  require(warmup_forget_s > 0 || !warmup_forget_restart_map,
+          "calibration.warmup_forget_restart_map needs warmup_forget_s > 0");
+  require(!(warmup_forget_s > 0 && warmup_replay_s > 0),
+          "calibration.warmup_forget_s and warmup_replay_s: choose one (forgetting replaces the "
+          "replay)");
   require(warmup_replay_passes >= 1 && warmup_replay_passes <= 10,
           "calibration.warmup_replay_passes must be in [1, 10]");
   // Without a replay span they would do nothing: say so rather than run without them.

@@ -31,10 +31,10 @@ namespace {
 
 const OdometryConfig& Validated(const OdometryConfig& config) {
   config.Validate();
-  if (config.calibration.replays_warmup()) {
+  if (config.calibration.replays_warmup() || config.calibration.forgets_warmup()) {
     throw std::invalid_argument(
-        "LioOdometry: calibration.warmup_replay_s > 0 needs CalibratingOdometry "
-        "(calibrating_odometry.h), which runs the warm-up replay around this single pass");
+        "LioOdometry: calibration.warmup_replay_s / warmup_forget_s > 0 need CalibratingOdometry "
+        "(calibrating_odometry.h), which runs the warm-up's replay or forgetting around this pass");
   }
   return config;
 }
@@ -291,6 +291,26 @@ double LioOdometry::SlideWindow() {
     estimator_->DropOldest();
   }
   return MsSince(t0);
+}
+
+MarginalizationReport LioOdometry::ForgetCalibrationInformation() {
+  std::vector<StateId> ids = calibration_.Ids(window_);
+  if (ids.empty()) return {};
+  // The gravity direction, refined with the extrinsic, was linearised in the same first seconds.
+  if (window_.HasState(kGravityKey) && !window_.IsStateConstant(kGravityKey)) {
+    ids.push_back(kGravityKey);
+  }
+  const MarginalizationReport report = window_.ForgetInformation(ids);
+  // The window's one marginal prior (each slide folds the previous one in), which the pose
+  // covariance reads, is on the calibration states (they connect to every knot): replaced.
+  if (report.removed_residual_blocks > 0) last_marginalization_.prior = report.prior;
+  return report;
+}
+
+void LioOdometry::RestartMap() {
+  if (map_insertion_.valid()) map_insertion_.get();  // the newest scan's, on the second thread
+  frontend_.map().Clear();
+  if (map_points_inserted_) InsertMapPoints();
 }
 
 SE3 LioOdometry::CurrentExtrinsic() const {

@@ -277,6 +277,8 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
            {"warmup_replay_passes", SetFromYaml(&o.warmup_replay_passes)},
            {"warmup_replay_hold", SetFromYaml(&o.warmup_replay_hold)},
            {"warmup_replay_freeze", SetFromYaml(&o.warmup_replay_freeze)},
+           {"warmup_forget_s", SetFromYaml(&o.warmup_forget_s)},
+           {"warmup_forget_restart_map", SetFromYaml(&o.warmup_forget_restart_map)},
            {"write_max_sigma_s",
             SetPositive(&o.write_max_sigma_s, source, section + ".write_max_sigma_s")},
            {"write_max_sigma_deg",

@@ -54,6 +54,7 @@
 
 namespace ctlio {
 
+class MarginalizationPrior;
 using StateId = std::int64_t;
 
 struct SlidingWindowOptions {
@@ -131,6 +132,18 @@ class SlidingWindow {
   // preprocessing, where more threads would only contend for the cores).
   bool solving() const { return solving_; }
   MarginalizationReport Marginalize(const std::vector<StateId>& ids);
+  // The marginal priors forget what they say about the listed states, which stay: every prior
+  // Marginalize left (not a MarginalizationPrior the caller added) on any of them is replaced by
+  // one prior on its other states, the Schur complement of the priors' information (linearised at
+  // the current estimate) over the listed states' coordinates, i.e. the other states' marginal.
+  // Residual blocks that are not marginal priors are kept as they are. Why: information
+  // marginalised while a static state (a calibration) was far off was linearised there and stays so
+  // (first-estimate Jacobians); with it forgotten, the state is estimated from the residuals kept
+  // or added after, linearised near its current value. Report: `marginalized` the listed states the
+  // priors touched, `kept` the new prior's states, `removed_residual_blocks` the priors replaced;
+  // nothing changes and the report is empty when no marginal prior touches them. Throws for unknown
+  // or repeated ids.
+  MarginalizationReport ForgetInformation(const std::vector<StateId>& ids);
 
   // Joint marginal covariance (tangent spaces, in the order of `ids`) of the listed states under
   // the Gauss–Newton model of the whole window at the current estimate: the pseudo-inverse of the
@@ -160,6 +173,10 @@ class SlidingWindow {
     std::shared_ptr<const ceres::Manifold> manifold;
     std::set<ceres::ResidualBlockId> residuals;
   };
+  // A MarginalizationPrior r = A·(x ⊟ x̄) + r0 on `kept` at their current values.
+  std::unique_ptr<MarginalizationPrior> MakePrior(const std::vector<StateId>& kept,
+                                                  const Eigen::MatrixXd& sqrt_information,
+                                                  const Eigen::VectorXd& r0) const;
   const StateBlock& Get(StateId id, int line) const;
   StateBlock& Get(StateId id, int line);
 
@@ -173,6 +190,8 @@ class SlidingWindow {
   // order, not in the order of their addresses, so that its result does not depend on the heap.
   std::unordered_map<ceres::ResidualBlockId, uint64_t> residual_serial_;
   uint64_t next_residual_serial_ = 0;
+  // The priors Marginalize and ForgetInformation added (not a caller's MarginalizationPrior).
+  std::set<ceres::ResidualBlockId> marginal_priors_;
 };
 
 }  // namespace ctlio

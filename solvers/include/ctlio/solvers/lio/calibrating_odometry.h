@@ -2,8 +2,12 @@
 // online calibration's warm-up replay around it (calibration_options.h, warmup_replay_s). Without
 // a replay configured it only forwards to the one pipeline and keeps the result history.
 //
-// With one, the first warmup_replay_s seconds of input (every IMU sample and scan as given) are
-// kept while the live pipeline processes them. After the first scan that ends past the span and
+// With calibration.warmup_forget_s instead, nothing is kept: after the first estimated scan that
+// ends past that span, the pipeline's marginal priors forget the calibration
+// (LioOdometry::ForgetCalibrationInformation) and it carries on.
+//
+// With a replay, the first warmup_replay_s seconds of input (every IMU sample and scan as given)
+// are kept while the live pipeline processes them. After the first scan that ends past the span and
 // was estimated, the span is processed again by a fresh pipeline started from the calibration the
 // live one ended with (ReplayConfig), in warmup_replay_passes passes, the last one optionally
 // held over the span (HoldCalibrationUntil) or frozen (FrozenCalibration); that pipeline replaces
@@ -121,6 +125,9 @@ class CalibratingOdometry {
   // replays them (Replay); gives up (note, data dropped) if twice the span passes without an
   // estimate.
   void MaybeReplay(ScanResult* result);
+  // calibration.warmup_forget_s: after the first estimated scan ending that long after the first
+  // scan began, the pipeline's marginal priors forget the calibration (noted in `result`).
+  void MaybeForget(const LidarScan& scan, ScanResult* result);
   // The passes over the kept data, here or (ReplaySchedule::background) started on a second
   // thread.
   void Replay(double span_s, ScanResult* result);
@@ -142,6 +149,9 @@ class CalibratingOdometry {
   bool keeping_ = false;
   std::vector<ImuSample> warmup_imu_;
   std::vector<std::pair<LidarScan, size_t>> warmup_scans_;
+  // calibration.warmup_forget_s: pending until done; the first scan's begin.
+  bool forgetting_ = false;
+  int64_t first_begin_ns_ = -1;
   // After a frozen last pass (calibration.warmup_replay_freeze): what every result reports.
   std::optional<ScanResult::CalibrationEstimate> frozen_;
   // A background replay and the end time of the scan that adopts it.

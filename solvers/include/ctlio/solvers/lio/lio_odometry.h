@@ -81,6 +81,13 @@ class LioOdometry {
   void HoldCalibrationUntil(double t_s, std::vector<bool> mask) {
     calibration_.HoldUntil(t_s, std::move(mask));
   }
+  // Between scans: the marginal priors forget what they say about the calibration states
+  // (SlidingWindow::ForgetInformation; calibration.warmup_forget_s, calibrating_odometry.h).
+  // What it replaced; empty without calibration states or a marginal prior on them.
+  MarginalizationReport ForgetCalibrationInformation();
+  // Between scans: the voxel map is emptied and holds the newest scan's points only (as after the
+  // first scan), e.g. when the map was built with a calibration far off.
+  void RestartMap();
   // The estimate T_mr sampled every 1/rate_hz s over the newest interval between states: the
   // grid times (multiples of the period in absolute ns) in (previous, newest state) and the newest
   // state's time, whose pose is the scan's T_mr. Empty before the second state.
