@@ -24,11 +24,10 @@
 namespace ctlio::lio {
 namespace {
 
-SlowSweepKeypoints Slow(int max_keypoints, double speed, double accel = 0.0) {
+SlowSweepKeypoints Slow(int max_keypoints, double speed) {
   SlowSweepKeypoints s;
   s.max_keypoints = max_keypoints;
   s.speed = speed;
-  s.accel = accel;
   return s;
 }
 
@@ -36,58 +35,36 @@ TEST(SweepKeypointBudget, SlowUnsplitSweepsGetTheSlowBudgetStrictlyBelowTheThres
   AdaptiveKnotOptions adaptive;
   adaptive.max_keypoints = 300;
   const SlowSweepKeypoints slow = Slow(1200, 4.0);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 0.0, 0.0), 1200);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, 0.0), 1200);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 3.999, 0.0), 1200);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 4.0, 0.0), 0);  // at the threshold: not slow
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 11.0, 0.0), 0);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 0.0), 1200);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4), 1200);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 3.999), 1200);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 4.0), 0);  // at the threshold: not slow
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 11.0), 0);
   // A diverged estimate is not slow.
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, std::numeric_limits<double>::quiet_NaN(), 0.0),
-            0);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, std::numeric_limits<double>::infinity(), 0.0),
-            0);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, std::numeric_limits<double>::quiet_NaN()), 0);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, std::numeric_limits<double>::infinity()), 0);
   // A split sweep has the split budget whatever its speed, also when that is the front end's (0).
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, true, 1.4, 0.0), 300);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, true, 11.0, 0.0), 300);
-  EXPECT_EQ(SweepKeypointCap(AdaptiveKnotOptions(), slow, true, 1.4, 0.0), 0);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, true, 1.4), 300);
+  EXPECT_EQ(SweepKeypointCap(adaptive, slow, true, 11.0), 300);
+  EXPECT_EQ(SweepKeypointCap(AdaptiveKnotOptions(), slow, true, 1.4), 0);
   // Off (the default): the front end's keypoints on every unsplit sweep.
   EXPECT_FALSE(SlowSweepKeypoints().enabled());
   for (const double v : {0.0, 1.4, 11.0}) {
-    EXPECT_EQ(SweepKeypointCap(adaptive, SlowSweepKeypoints(), false, v, 0.0), 0) << v;
-    EXPECT_EQ(SweepKeypointCap(adaptive, Slow(0, 100.0), false, v, 0.0), 0) << v;
-  }
-}
-
-TEST(SweepKeypointBudget, WithAnAccelerationThresholdASlowSweepMustAlsoBeCalm) {
-  const AdaptiveKnotOptions adaptive;
-  const SlowSweepKeypoints slow = Slow(1200, 4.0, 7.0);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, 0.0), 1200);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, 6.99), 1200);
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, 7.0), 0);   // at the threshold: not calm
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, 22.0), 0);  // handheld fast
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 11.0, 1.0), 0);  // a calm drive
-  EXPECT_EQ(SweepKeypointCap(adaptive, slow, false, 1.4, std::numeric_limits<double>::quiet_NaN()),
-            0);
-  // Without the condition (0, the default) the acceleration is not read, NaN included.
-  for (const double a : {0.0, 22.0, std::numeric_limits<double>::quiet_NaN()}) {
-    EXPECT_EQ(SweepKeypointCap(adaptive, Slow(1200, 4.0), false, 1.4, a), 1200) << a;
+    EXPECT_EQ(SweepKeypointCap(adaptive, SlowSweepKeypoints(), false, v), 0) << v;
+    EXPECT_EQ(SweepKeypointCap(adaptive, Slow(0, 100.0), false, v), 0) << v;
   }
 }
 
 TEST(SweepKeypointBudget, KeysAreReadAndChecked) {
   const std::string path = ::testing::TempDir() + "/slow_sweep_keypoints.yaml";
-  std::ofstream(path) << "window:\n  slow_sweep_max_keypoints: 1200\n  slow_sweep_speed: 3.5\n"
-                         "  slow_sweep_accel: 7\n";
+  std::ofstream(path) << "window:\n  slow_sweep_max_keypoints: 1200\n  slow_sweep_speed: 3.5\n";
   const OdometryConfig c = LoadOdometryConfig(path);
   EXPECT_EQ(c.slow_sweep_keypoints.max_keypoints, 1200);
   EXPECT_EQ(c.slow_sweep_keypoints.speed, 3.5);
-  EXPECT_EQ(c.slow_sweep_keypoints.accel, 7.0);
-  EXPECT_EQ(OdometryConfig().slow_sweep_keypoints.accel, 0.0);        // no condition in code
   EXPECT_EQ(OdometryConfig().slow_sweep_keypoints.max_keypoints, 0);  // off in code
   for (const std::string& bad :
        {std::string("slow_sweep_max_keypoints: -5"), std::string("slow_sweep_speed: 0"),
-        std::string("slow_sweep_speed: -1"), std::string("slow_sweep_speed: .nan"),
-        std::string("slow_sweep_accel: -1"), std::string("slow_sweep_accel: .inf")}) {
+        std::string("slow_sweep_speed: -1"), std::string("slow_sweep_speed: .nan")}) {
     std::ofstream(path) << "window:\n  " << bad << "\n";
     try {
       LoadOdometryConfig(path);
@@ -103,9 +80,7 @@ TEST(SweepKeypointBudget, KeysAreReadAndChecked) {
   EXPECT_THROW(v.Validate(), std::invalid_argument);
   v.slow_sweep_keypoints = Slow(1200, std::numeric_limits<double>::infinity());
   EXPECT_THROW(v.Validate(), std::invalid_argument);
-  v.slow_sweep_keypoints = Slow(1200, 4.0, std::numeric_limits<double>::quiet_NaN());
-  EXPECT_THROW(v.Validate(), std::invalid_argument);
-  v.slow_sweep_keypoints = Slow(1200, 4.0, 7.0);
+  v.slow_sweep_keypoints = Slow(1200, 4.0);
   EXPECT_NO_THROW(v.Validate());
 }
 
@@ -163,26 +138,6 @@ TEST(SweepKeypointBudget, AWalkBelowTheThresholdRegistersTheSlowBudget) {
   for (size_t i = moving.size() - 5; i < moving.size(); ++i) {
     ASSERT_NE(moving[i].status, ScanStatus::kFailed) << "scan " << i;
     EXPECT_LE(moving[i].keypoints, 40) << "scan " << i;
-  }
-
-  // An acceleration threshold no moving sweep is below (0.01 m/s²; the gait's accelerations are
-  // ~1-5 m/s²): the walk's moving sweeps keep the front end's 40. One above every sweep's (1000):
-  // the run with the speed condition alone, bit for bit.
-  OdometryConfig restless = base;
-  restless.slow_sweep_keypoints = Slow(120, 4.0, 0.01);
-  const std::vector<ScanResult> calm_only = RunWalk(restless);
-  ASSERT_EQ(calm_only.size(), capped.size());
-  for (size_t i = calm_only.size() - 5; i < calm_only.size(); ++i) {
-    ASSERT_NE(calm_only[i].status, ScanStatus::kFailed) << "scan " << i;
-    EXPECT_LE(calm_only[i].keypoints, 40) << "scan " << i;
-  }
-  OdometryConfig any_accel = base;
-  any_accel.slow_sweep_keypoints = Slow(120, 4.0, 1000.0);
-  const std::vector<ScanResult> same = RunWalk(any_accel);
-  ASSERT_EQ(same.size(), slow.size());
-  for (size_t i = 0; i < slow.size(); ++i) {
-    EXPECT_EQ(same[i].keypoints, slow[i].keypoints) << "scan " << i;
-    EXPECT_EQ(same[i].T_mr.Matrix(), slow[i].T_mr.Matrix()) << "scan " << i;
   }
 }
 

@@ -260,13 +260,11 @@ void GpKnotEstimator::AddState(const PreparedScan& scan, SlidingWindow* window,
   const int K = KnotsForScan(t_prev, scan.t_end);
   split_sweep_ = K > config_.knots_per_scan;
   // The sweep's own keypoint budget when it has one (a split sweep, or a slow one:
-  // sweep_keypoint_budget.h), judged on the newest knot's solved speed and acceleration at the
-  // sweep's start; chosen from the same preprocessed points with the front end's rule, so only
-  // the cap differs.
+  // sweep_keypoint_budget.h), judged on the newest knot's solved speed at the sweep's start;
+  // chosen from the same preprocessed points with the front end's rule, so only the cap differs.
   const double speed = Eigen::Map<const Vec6>(knots_.back().velocity).head<3>().norm();
-  const double accel = Eigen::Map<const Vec6>(knots_.back().acceleration).head<3>().norm();
-  const int cap = SweepKeypointCap(config_.adaptive_knots, config_.slow_sweep_keypoints,
-                                   split_sweep_, speed, accel);
+  const int cap =
+      SweepKeypointCap(config_.adaptive_knots, config_.slow_sweep_keypoints, split_sweep_, speed);
   use_own_keypoints_ = cap > 0;
   if (use_own_keypoints_) {
     own_keypoints_ = KeypointsOf(scan.points, config_.frontend.keypoint_voxel_size, cap);

@@ -218,7 +218,6 @@ void ApplySections(const YAML::Node& root, const std::string& source, const std:
             SetInRange(&c->slow_sweep_keypoints.max_keypoints, 0, 1000000, source,
                        section + ".slow_sweep_max_keypoints")},
            {"slow_sweep_speed", SetFromYaml(&c->slow_sweep_keypoints.speed)},
-           {"slow_sweep_accel", SetFromYaml(&c->slow_sweep_keypoints.accel)},
            {"threads",
             SetInRange(&c->solver_threads, 1, kMaxConfigThreads, source, section + ".threads")},
            {"overlap", SetFromYaml(&c->overlap_stages)},
