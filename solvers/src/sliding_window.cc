@@ -105,12 +105,7 @@ double* SlidingWindow::AddVectorState(StateId id, const Eigen::VectorXd& v) {
 
 void SlidingWindow::RemoveState(StateId id) {
   StateBlock& block = Get(id, __LINE__);
-  std::vector<ceres::ResidualBlockId> residuals(block.residuals.begin(), block.residuals.end());
-  std::sort(residuals.begin(), residuals.end(),
-            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
-              return residual_serial_.at(a) < residual_serial_.at(b);
-            });
-  for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
+  for (ceres::ResidualBlockId r : InAddedOrder(block.residuals)) RemoveResidualBlock(r);
   problem_->RemoveParameterBlock(block.values.get());
   states_.erase(id);
 }
@@ -257,31 +252,10 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
   report.removed_residual_blocks = static_cast<int>(residual_set.size());
   // In the order they were added (not by address): the linearisation's sums and Ceres' residual
   // order after the removals below then do not depend on the heap layout.
-  std::vector<ceres::ResidualBlockId> residuals(residual_set.begin(), residual_set.end());
-  std::sort(residuals.begin(), residuals.end(),
-            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
-              return residual_serial_.at(a) < residual_serial_.at(b);
-            });
-
+  const std::vector<ceres::ResidualBlockId> residuals = InAddedOrder(residual_set);
   // Everything that can throw happens before the window changes.
-  Eigen::MatrixXd sqrt_information;
-  Eigen::VectorXd r0;
-  if (!residual_set.empty()) {
-    std::vector<StateId> ordering(report.marginalized);
-    ordering.insert(ordering.end(), report.kept.begin(), report.kept.end());
-    Eigen::MatrixXd H;
-    Eigen::VectorXd b;
-    Linearize(residuals, ordering, &H, &b);
-    const SchurComplementResult schur = SchurComplementLeading(
-        H, b, report.marginalized_dimension, options_.relative_eigenvalue_threshold);
-    report.marginalized_rank = schur.marginalized_rank;
-    if (!kept.empty()) {
-      report.prior_rank = InformationSquareRoot(schur.information, schur.vector, &sqrt_information,
-                                                &r0, options_.relative_eigenvalue_threshold);
-    }
-  }
   std::unique_ptr<MarginalizationPrior> prior;
-  if (report.prior_rank > 0) prior = MakePrior(report.kept, sqrt_information, r0);
+  if (!residual_set.empty()) prior = SchurPrior(residuals, &report);
 
   for (ceres::ResidualBlockId r : residuals) RemoveResidualBlock(r);
   for (StateId id : leaving) {
@@ -295,13 +269,36 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
   return report;
 }
 
-std::unique_ptr<MarginalizationPrior> SlidingWindow::MakePrior(
-    const std::vector<StateId>& kept, const Eigen::MatrixXd& sqrt_information,
-    const Eigen::VectorXd& r0) const {
+std::vector<ceres::ResidualBlockId> SlidingWindow::InAddedOrder(
+    const std::set<ceres::ResidualBlockId>& residuals) const {
+  std::vector<ceres::ResidualBlockId> ordered(residuals.begin(), residuals.end());
+  std::sort(ordered.begin(), ordered.end(),
+            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
+              return residual_serial_.at(a) < residual_serial_.at(b);
+            });
+  return ordered;
+}
+
+std::unique_ptr<MarginalizationPrior> SlidingWindow::SchurPrior(
+    const std::vector<ceres::ResidualBlockId>& residuals, MarginalizationReport* report) const {
+  std::vector<StateId> ordering(report->marginalized);
+  ordering.insert(ordering.end(), report->kept.begin(), report->kept.end());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  Linearize(residuals, ordering, &H, &b);
+  const SchurComplementResult schur = SchurComplementLeading(
+      H, b, report->marginalized_dimension, options_.relative_eigenvalue_threshold);
+  report->marginalized_rank = schur.marginalized_rank;
+  if (report->kept.empty()) return nullptr;
+  Eigen::MatrixXd sqrt_information;
+  Eigen::VectorXd r0;
+  report->prior_rank = InformationSquareRoot(schur.information, schur.vector, &sqrt_information,
+                                             &r0, options_.relative_eigenvalue_threshold);
+  if (report->prior_rank == 0) return nullptr;
   std::vector<const ceres::Manifold*> manifolds;
   std::vector<int> sizes;
   std::vector<const double*> points;
-  for (StateId id : kept) {
+  for (StateId id : report->kept) {
     const StateBlock& block = states_.at(id);
     manifolds.push_back(block.manifold.get());
     sizes.push_back(block.ambient_size);
@@ -335,30 +332,11 @@ MarginalizationReport SlidingWindow::ForgetInformation(const std::vector<StateId
   report.kept.assign(kept.begin(), kept.end());
   report.removed_residual_blocks = static_cast<int>(prior_set.size());
   for (StateId id : touched) report.marginalized_dimension += states_.at(id).tangent_size;
-  std::vector<ceres::ResidualBlockId> priors(prior_set.begin(), prior_set.end());
-  std::sort(priors.begin(), priors.end(),
-            [this](ceres::ResidualBlockId a, ceres::ResidualBlockId b) {
-              return residual_serial_.at(a) < residual_serial_.at(b);
-            });
+  const std::vector<ceres::ResidualBlockId> priors = InAddedOrder(prior_set);
   // The priors' joint Gaussian, linearised at the current estimate as Marginalize linearises an
   // older prior, integrated over the forgotten states: the Schur complement onto the others
   // is their marginal, so they keep exactly what the priors said about them.
-  Eigen::MatrixXd sqrt_information;
-  Eigen::VectorXd r0;
-  std::vector<StateId> ordering(report.marginalized);
-  ordering.insert(ordering.end(), report.kept.begin(), report.kept.end());
-  Eigen::MatrixXd H;
-  Eigen::VectorXd b;
-  Linearize(priors, ordering, &H, &b);
-  const SchurComplementResult schur = SchurComplementLeading(
-      H, b, report.marginalized_dimension, options_.relative_eigenvalue_threshold);
-  report.marginalized_rank = schur.marginalized_rank;
-  if (!kept.empty()) {
-    report.prior_rank = InformationSquareRoot(schur.information, schur.vector, &sqrt_information,
-                                              &r0, options_.relative_eigenvalue_threshold);
-  }
-  std::unique_ptr<MarginalizationPrior> prior;
-  if (report.prior_rank > 0) prior = MakePrior(report.kept, sqrt_information, r0);
+  std::unique_ptr<MarginalizationPrior> prior = SchurPrior(priors, &report);
   for (ceres::ResidualBlockId r : priors) RemoveResidualBlock(r);
   if (prior != nullptr) {
     report.prior = AddResidualBlock(prior.release(), nullptr, report.kept);

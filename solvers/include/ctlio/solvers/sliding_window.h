@@ -173,10 +173,15 @@ class SlidingWindow {
     std::shared_ptr<const ceres::Manifold> manifold;
     std::set<ceres::ResidualBlockId> residuals;
   };
-  // A MarginalizationPrior r = A·(x ⊟ x̄) + r0 on `kept` at their current values.
-  std::unique_ptr<MarginalizationPrior> MakePrior(const std::vector<StateId>& kept,
-                                                  const Eigen::MatrixXd& sqrt_information,
-                                                  const Eigen::VectorXd& r0) const;
+  // `residuals` sorted by the order they were added (not by address), so that sums over them and
+  // Ceres' order after removals do not depend on the heap layout.
+  std::vector<ceres::ResidualBlockId> InAddedOrder(
+      const std::set<ceres::ResidualBlockId>& residuals) const;
+  // The prior `residuals` (linearised at the current estimate) leave on report->kept once
+  // report->marginalized are integrated out (Schur complement, steps 2–4 above), at the kept
+  // states' current values; fills report's ranks. nullptr when nothing is kept or of rank 0.
+  std::unique_ptr<MarginalizationPrior> SchurPrior(
+      const std::vector<ceres::ResidualBlockId>& residuals, MarginalizationReport* report) const;
   const StateBlock& Get(StateId id, int line) const;
   StateBlock& Get(StateId id, int line);
 
