@@ -6,7 +6,7 @@ sequence index and method, (1) a run calibrating from the wrong start (3 deg / 1
 
   tools/calibration_triples.py run --out DIR --regimes walking,medium,fast --indices 0-9 \
       --methods singer_lio,imu_input --workers 2
-  tools/calibration_triples.py table --out DIR [--indices 0-9] [--runs]
+  tools/calibration_triples.py table --out DIR [--indices 0-9] [--runs] [--plot PNG]
 
 Run from the repository root (configs data/sim_lio.yaml,data/calibration.yaml, or --config with a
 variant on top). Each triple goes to DIR/REGIME/INDEX/METHOD/{cal,pasted,true}; finished runs are
@@ -134,6 +134,7 @@ def table(args):
           "per run (within 10 %) | ATE true values, mean | CPU per scan: calibrating / without "
           "(median of runs) | live thread: longest scan CPU | replay CPU |")
     print("|---|---|---|---|---|---|---|---|---|---|")
+    plotted = []
     for regime in args.regimes.split(","):
         for method in args.methods.split(","):
             rows = [r for r in (summary(args.out, regime, i, method) for i in indices(args.indices))
@@ -156,12 +157,46 @@ def table(args):
                   f"{min(live):.2f}–{max(live):.2f}×; with the replay {min(total):.2f}–"
                   f"{max(total):.2f}×) | {max(r['longest'] for r in rows):.0f} ms | "
                   f"{statistics.median(r['replay_s'] for r in rows):.1f} s |")
+            plotted.append((regime, method, rows, ratios))
             if args.runs:
                 for r, x in zip(rows, ratios):
                     print(f"  {regime}/{r['index']} {method}: written {r['dt']:.3f} ms "
                           f"{r['deg']:.3f}° {r['cm']:.2f} cm{'' if r['ok'] else ' (miss)'}, "
                           f"pasted {r['pasted']:.3f} / true {r['true']:.3f} cm = {x:.2f}, "
                           f"longest live scan {r['longest']:.0f} ms")
+    if args.plot and plotted:
+        plot(args.plot, plotted)
+
+
+def plot(path, plotted):
+    """Per run: the written error of each kind over its target, and the pasted ÷ true ATE."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for k, (regime, method, rows, ratios) in enumerate(plotted):
+        x = [k + 0.8 * (i / max(1, len(rows) - 1) - 0.5) for i in range(len(rows))]
+        for key, target, marker in (("dt", TARGETS[0], "o"), ("deg", TARGETS[1], "^"),
+                                    ("cm", TARGETS[2], "s")):
+            a.scatter(x, [r[key] / target for r in rows], marker=marker, s=14,
+                      color="C%d" % ("dt", "deg", "cm").index(key),
+                      label={"dt": "clock offset / 0.5 ms", "deg": "rotation / 0.1°",
+                             "cm": "lever arm / 1 cm"}[key] if k == 0 else None)
+        b.scatter(x, ratios, s=14, color="k")
+    labels = [f"{regime}\n{method}" for regime, method, _, _ in plotted]
+    for ax in (a, b):
+        ax.set_xticks(range(len(plotted)))
+        ax.set_xticklabels(labels, fontsize=8)
+    a.axhline(1.0, color="r", lw=0.8)
+    a.set_ylabel("written error ÷ target")
+    a.set_title("written calibration, per run (target: below 1)")
+    a.legend(fontsize=8)
+    b.axhspan(0.9, 1.1, color="g", alpha=0.15, lw=0)
+    b.set_ylabel("ATE pasted ÷ ATE true values")
+    b.set_title("pasted run, per run (target: within the band)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"wrote {path}")
 
 
 def main():
@@ -175,6 +210,8 @@ def main():
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--binary", default="build/apps/lio/ctlio_odometry")
     p.add_argument("--runs", action="store_true", help="table: one line per run as well")
+    p.add_argument("--plot", default="", help="table: a PNG of the per-run written errors and "
+                   "pasted ÷ true ATE")
     p.add_argument("--kinds", default="cal,pasted,true",
                    help="run: which runs of each triple (a variant of the calibrating configs can "
                    "share the true-value runs of another directory: link them into DIR)")

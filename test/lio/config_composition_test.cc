@@ -107,7 +107,18 @@ TEST(OdometryConfigComposition, CalibrationOverlayWorksOnEveryShippedConfig) {
     EXPECT_DOUBLE_EQ(cal.accel_variance, own.accel_variance);
     EXPECT_DOUBLE_EQ(cal.frontend.voxel_size, own.frontend.voxel_size);
     EXPECT_EQ(cal.qc, own.qc);
-    EXPECT_EQ(cal.per_method.size(), own.per_method.size());
+    // Singer-LIO's denser keypoints (per_method.singer_lio), every other method the file's.
+    const OdometryConfig singer = cal.ForMethod(LioMethod::kSingerLio);
+    EXPECT_EQ(singer.frontend.max_keypoints, 4800);
+    EXPECT_DOUBLE_EQ(singer.frontend.voxel_size, 0.5);
+    EXPECT_DOUBLE_EQ(singer.frontend.initial_voxel_size, 0.5);
+    EXPECT_DOUBLE_EQ(singer.frontend.keypoint_voxel_size, 0.5);
+    EXPECT_TRUE(singer.calibration.estimate_extrinsic);
+    EXPECT_EQ(cal.per_method.size(),
+              own.per_method.size() + (own.per_method.count(LioMethod::kSingerLio) ? 0 : 1));
+    const OdometryConfig baseline = cal.ForMethod(LioMethod::kImuInput);
+    EXPECT_DOUBLE_EQ(baseline.frontend.voxel_size,
+                     own.ForMethod(LioMethod::kImuInput).frontend.voxel_size);
   }
   // data/sim_lio_calibration.yaml is that composition on sim_lio.yaml plus the simulated
   // sensors' keys.

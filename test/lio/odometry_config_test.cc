@@ -413,7 +413,10 @@ TEST(OdometryConfig, CalibrationConfigExtendsTheSimConfig) {
   EXPECT_EQ(cal.frontend.max_iterations, sim.frontend.max_iterations);
   EXPECT_DOUBLE_EQ(cal.frontend.point_noise_sigma, sim.frontend.point_noise_sigma);
   EXPECT_NE(sim.frontend.max_keypoints, LidarFrontendOptions().max_keypoints);
-  EXPECT_EQ(cal.per_method.size(), sim.per_method.size());
+  // The base's overrides, and Singer-LIO's denser keypoints of the calibration overlay.
+  EXPECT_EQ(sim.per_method.count(LioMethod::kSingerLio), 0u);
+  EXPECT_EQ(cal.per_method.size(), sim.per_method.size() + 1);
+  EXPECT_EQ(cal.ForMethod(LioMethod::kSingerLio).frontend.max_keypoints, 4800);
   ASSERT_FALSE(sim.per_method.empty());
   for (const auto& [method, override_config] : sim.per_method) {
     ASSERT_EQ(cal.per_method.count(method), 1u);
