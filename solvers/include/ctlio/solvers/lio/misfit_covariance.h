@@ -36,8 +36,7 @@
 namespace ctlio::lio {
 
 // The variance factor f of (1): χ²/dof where χ² exceeds its 0.999 quantile (ChiSquareQuantile,
-// chi_square.h) and χ²/dof > 1;
-// else 1 (also for dof ≤ 0 or a non-finite χ²).
+// chi_square.h) and χ²/dof > 1; else 1 (also for dof ≤ 0 or a non-finite χ²).
 double MisfitFactor(double chi2, int dof);
 
 // The newest interval's motion-model blocks: every residual block on `newest` states except
