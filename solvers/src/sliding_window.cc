@@ -250,8 +250,6 @@ MarginalizationReport SlidingWindow::Marginalize(const std::vector<StateId>& ids
   }
   report.kept.assign(kept.begin(), kept.end());
   report.removed_residual_blocks = static_cast<int>(residual_set.size());
-  // In the order they were added (not by address): the linearisation's sums and Ceres' residual
-  // order after the removals below then do not depend on the heap layout.
   const std::vector<ceres::ResidualBlockId> residuals = InAddedOrder(residual_set);
   // Everything that can throw happens before the window changes.
   std::unique_ptr<MarginalizationPrior> prior;
