@@ -52,6 +52,12 @@ void LidarFrontendOptions::Validate() const {
           "max_iterations_without_imu must be in [0, 100] (0 = max_iterations)");
   require(solver_iterations_without_imu >= 0 && solver_iterations_without_imu <= 1000,
           "solver_iterations_without_imu must be in [0, 1000] (0 = solver_iterations)");
+  require(high_speed >= 0.0 && high_speed <= 1000.0,
+          "high_speed must be in [0, 1000] m/s (0 = off)");
+  require(max_iterations_high_speed >= 0 && max_iterations_high_speed <= 100,
+          "max_iterations_high_speed must be in [0, 100] (0 = max_iterations)");
+  require(solver_iterations_high_speed >= 0 && solver_iterations_high_speed <= 1000,
+          "solver_iterations_high_speed must be in [0, 1000] (0 = solver_iterations)");
   require(loss == "cauchy" || loss == "huber" || loss == "none",
           "loss must be cauchy, huber or none");
   require(residual_blocks == "point" || residual_blocks == "interval" ||
@@ -100,6 +106,9 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"solver_iterations", SetFromYaml(&o.solver_iterations)},
       {"max_iterations_without_imu", SetFromYaml(&o.max_iterations_without_imu)},
       {"solver_iterations_without_imu", SetFromYaml(&o.solver_iterations_without_imu)},
+      {"high_speed", SetFromYaml(&o.high_speed)},
+      {"max_iterations_high_speed", SetFromYaml(&o.max_iterations_high_speed)},
+      {"solver_iterations_high_speed", SetFromYaml(&o.solver_iterations_high_speed)},
       {"point_noise_sigma", SetFromYaml(&o.point_noise_sigma)},
       {"point_noise_angle",
        SetInRange(&o.point_noise_angle, 0.0, 0.1, source, "lidar_frontend.point_noise_angle")},

@@ -16,6 +16,7 @@
 #include "ctlio/solvers/lio/imu_consistency.h"
 #include "ctlio/solvers/lio/input_checks.h"
 #include "ctlio/solvers/lio/pose_covariance_report.h"
+#include "ctlio/solvers/lio/registration_budget.h"
 #include "ctlio/solvers/lio/scan_preparation.h"
 #include "ctlio/solvers/lio/scan_status.h"
 #include "ctlio/solvers/lio/state_keys.h"
@@ -221,8 +222,11 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
   result->keypoints = static_cast<int>(lidar->num_keypoints());  // a sweep's own budget
   calibration_.Hold(scan.t_end, &window_, result);
-  const RegistrationSummary registered = without_imu_.Register(
-      config_.frontend, registration_, frontend_.map(), lidar.get(), &window_);
+  const double speed = PredictedSpeed(estimator_->PreviousPose(), predicted,
+                                      estimator_->newest_time() - estimator_->previous_time());
+  const RegistrationSummary registered =
+      RegisterWithin(ScanBudget(config_.frontend, without_imu_.active(), speed), registration_,
+                     frontend_.map(), lidar.get(), &window_);
   calibration_.Release(&window_);
   if (!registered.degenerate) AnalyseDegeneracy(registered, predicted, result);
   result->rounds = registered.rounds;

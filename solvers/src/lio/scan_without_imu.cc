@@ -15,22 +15,6 @@ void ScanWithoutImu::Begin(bool applies, const std::vector<StateId>& keys,
   for (const StateId id : keys) start_.emplace_back(id, window.Vector(id));
 }
 
-RegistrationSummary ScanWithoutImu::Register(const LidarFrontendOptions& options,
-                                             const ScanRegistration& registration,
-                                             const VoxelMap& map, LidarTerm* term,
-                                             SlidingWindow* window) const {
-  if (!active()) return registration.Register(map, term, window);
-  int& iterations = window->options().solver.max_num_iterations;
-  const int kept = iterations;
-  if (options.solver_iterations_without_imu > 0) {
-    iterations = options.solver_iterations_without_imu;
-  }
-  RegistrationSummary registered =
-      registration.Register(map, term, window, options.max_iterations_without_imu);
-  iterations = kept;
-  return registered;
-}
-
 bool ScanWithoutImu::Restore(const RegistrationSummary& registered, SlidingWindow* window) const {
   if (!active()) return false;
   for (const ceres::ResidualBlockId id : registered.lidar_blocks) window->RemoveResidualBlock(id);

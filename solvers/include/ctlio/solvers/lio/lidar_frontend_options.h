@@ -77,6 +77,17 @@ struct LidarFrontendOptions {
   // samples keep the budget above, so runs without an outage are unchanged bit for bit.
   int max_iterations_without_imu = 10;
   int solver_iterations_without_imu = 5;
+  // The budget of a scan predicted at high speed (registration_budget.h): a scan whose predicted
+  // mean speed over its interval is at least high_speed [m/s] gets max_iterations_high_speed ×
+  // solver_iterations_high_speed (0 = max_iterations / solver_iterations). At 12–14 m/s the
+  // IMU-as-input baseline's 4 rounds × 3 stop short and its rotation drifts from ~13 s of a 20 s
+  // drive (os1_64 town 0: 5.15 m ATE; 10 × 5: 7.2 cm), while the same budget on walking and
+  // handheld-fast sweeps (≤ 3 m/s) costs accuracy (docs/experiments/scoreboard.md, "The
+  // baseline's budget in 20 s drives"). 0 = off: every scan below it keeps the budget above,
+  // bit for bit. A scan without IMU samples keeps its own budget.
+  double high_speed = 0.0;  // m/s
+  int max_iterations_high_speed = 0;
+  int solver_iterations_high_speed = 0;
   // Standard deviation of a point-to-plane residual (range noise of an OS1-64 class lidar plus
   // plane-fit noise): residuals enter the problem as w/σ · nᵀ(p_ref − T_mr q), which sets their
   // weight against the GP prior (whitened by Q⁻¹, SPEC §2).

@@ -1,0 +1,42 @@
+#include "ctlio/solvers/lio/registration_budget.h"
+
+namespace ctlio::lio {
+
+RegistrationBudget ScanBudget(const LidarFrontendOptions& options, bool without_imu, double speed) {
+  RegistrationBudget budget{options.max_iterations, options.solver_iterations};
+  int rounds = 0, iterations = 0;
+  if (without_imu) {
+    rounds = options.max_iterations_without_imu;
+    iterations = options.solver_iterations_without_imu;
+  } else if (options.high_speed > 0.0 && speed >= options.high_speed) {
+    rounds = options.max_iterations_high_speed;
+    iterations = options.solver_iterations_high_speed;
+  }
+  if (rounds > 0) budget.rounds = rounds;
+  if (iterations > 0) budget.solver_iterations = iterations;
+  return budget;
+}
+
+double PredictedSpeed(const SE3& previous, const SE3& newest, double dt) {
+  if (!(dt > 0.0)) return 0.0;
+  return (newest.translation() - previous.translation()).norm() / dt;
+}
+
+RegistrationSummary RegisterWithin(const RegistrationBudget& budget,
+                                   const ScanRegistration& registration, const VoxelMap& map,
+                                   LidarTerm* term, SlidingWindow* window) {
+  int& iterations = window->options().solver.max_num_iterations;
+  const int kept = iterations;
+  iterations = budget.solver_iterations;
+  RegistrationSummary registered;
+  try {
+    registered = registration.Register(map, term, window, budget.rounds);
+  } catch (...) {
+    iterations = kept;
+    throw;
+  }
+  iterations = kept;
+  return registered;
+}
+
+}  // namespace ctlio::lio
