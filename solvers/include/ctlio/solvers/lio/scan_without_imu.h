@@ -1,9 +1,10 @@
 // A GP method's scan that no IMU sample measures: every lidar_only scan, and a Singer-LIO or
 // lidar_gyro scan inside an IMU outage (docs/experiments/imu-dropout.md). Only the lidar moves its
 // states away from the prior's prediction, so such a scan
-// - is registered with its own, larger budget (registration_budget.h;
-//   LidarFrontendOptions::max_iterations_without_imu, solver_iterations_without_imu): the normal 2 rounds × 3 iterations stop before converging and
-//   the error compounds (hdl32e quad walk 101, 2 s outage: 29 m, with the larger budget 0.029 m);
+// - is registered with its own, larger budget (LidarFrontendOptions::max_iterations_without_imu,
+//   solver_iterations_without_imu; registration_budget.h): the normal 2 rounds × 3 iterations stop
+//   before converging and the error compounds (hdl32e quad walk 101, 2 s outage: 29 m, with the
+//   larger budget 0.029 m);
 // - keeps the prediction along its degenerate directions (LioOdometry::AnalyseDegeneracy);
 // - if its estimate is implausible, goes back to the prediction: its lidar residuals leave the
 //   window and its states get their starting values again, so that the next scan starts from the
