@@ -25,18 +25,15 @@ double PredictedSpeed(const SE3& previous, const SE3& newest, double dt) {
 RegistrationSummary RegisterWithin(const RegistrationBudget& budget,
                                    const ScanRegistration& registration, const VoxelMap& map,
                                    LidarTerm* term, SlidingWindow* window) {
-  int& iterations = window->options().solver.max_num_iterations;
-  const int kept = iterations;
-  iterations = budget.solver_iterations;
-  RegistrationSummary registered;
-  try {
-    registered = registration.Register(map, term, window, budget.rounds);
-  } catch (...) {
-    iterations = kept;
-    throw;
-  }
-  iterations = kept;
-  return registered;
+  // The window's own count comes back however Register leaves (it may throw).
+  struct Restore {
+    int& value;
+    const int kept;
+    ~Restore() { value = kept; }
+  } restore{window->options().solver.max_num_iterations,
+            window->options().solver.max_num_iterations};
+  restore.value = budget.solver_iterations;
+  return registration.Register(map, term, window, budget.rounds);
 }
 
 }  // namespace ctlio::lio
