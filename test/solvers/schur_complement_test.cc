@@ -1,6 +1,7 @@
 // Dense marginalisation algebra (solvers/schur_complement.h) against direct inversion.
 #include "ctlio/solvers/schur_complement.h"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -163,7 +164,7 @@ TEST(SchurComplement, BadInputThrows) {
     SchurComplement(H, b, {0}, {5});
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("schur_complement.h"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("schur_complement.cc"), std::string::npos);
   }
 }
 
