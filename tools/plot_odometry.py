@@ -79,14 +79,6 @@ def read_scans(path):
             if len(p) > ms_col:
                 scans.append((float(p[t_col]), p[status_col], float(p[ms_col])))
     return scans
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#"):
-                continue
-            p = line.split()
-            if len(p) >= 9:
-                scans.append((float(p[0]), p[1], float(p[8])))
-    return scans
 
 
 def read_errors(path):

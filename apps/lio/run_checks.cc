@@ -55,8 +55,9 @@ std::string DegenerateRunWarning(const std::vector<lio::ScanResult>& scans, doub
                 "%zu of %zu scans degenerate (first: scan %zu at %.3f s): the lidar did not fix "
                 "their pose, which there is the motion prior's and the IMU's dead reckoning; too "
                 "few points or planes after subsampling (lidar_frontend.voxel_size, "
-                "keypoint_voxel_size, max_keypoints), points outside min_range/max_range, or a "
-                "featureless scene",
+                "keypoint_voxel_size, max_keypoints), points outside min_range/max_range, a "
+                "featureless scene, or registrations rejected in an IMU outage "
+                "(lidar_frontend.max_correction_without_imu); scans.log has each scan's reason",
                 degenerate, judged, first, 1e-9 * double(scans[first].t_ns));
   return text;
 }

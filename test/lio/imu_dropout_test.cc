@@ -174,6 +174,61 @@ TEST(ImuDropout, BudgetWithoutImuIsReadAndChecked) {
                        {"solver_iterations_without_imu"});
 }
 
+// lidar_frontend.max_correction_without_imu: a scan in an outage whose registration moves the
+// pose further from the prediction than the limit is rejected (degenerate, the distance and the
+// key in its message), keeps the prediction and leaves the map alone; scans with IMU samples are
+// never rejected, and a limit no scan reaches gives the run without it bit for bit. The medium
+// sequence of the first test; a limit of 0.1 mm rejects every scan of the outage (registered,
+// they move 5–11 cm from their predictions there), so the GP prior alone carries the 1 s.
+TEST(ImuDropout, ACorrectionBeyondTheLimitInAnOutageKeepsThePrediction) {
+  const auto run_with = [](double limit) {
+    OdometryConfig c = Config(LioMethod::kSingerLio);
+    c.frontend.max_correction_without_imu = limit;
+    sim::SimulatedSource source(SequenceWithOutage());
+    return lioapp::RunOdometry(source, c);
+  };
+  const lioapp::RunSummary off = run_with(0.0), far = run_with(100.0), tight = run_with(1e-4);
+  ASSERT_EQ(off.scans.size(), tight.scans.size());
+  ASSERT_EQ(off.scans.size(), far.scans.size());
+  int rejected = 0;
+  for (size_t i = 0; i < off.scans.size(); ++i) {
+    const ScanResult &o = off.scans[i], &t = tight.scans[i];
+    EXPECT_TRUE(far.scans[i].T_mr.Matrix() == o.T_mr.Matrix()) << i;
+    EXPECT_GE(o.correction_m, 0.0) << i;
+    if (o.status == ScanStatus::kInitialising) continue;
+    // The GP's extrapolation over one sweep of medium motion: measured 0–0.19 m with the IMU.
+    if (o.imu_residuals > 0) EXPECT_LT(o.correction_m, 0.25) << i;
+    if (o.imu_residuals > 0 && rejected == 0) {
+      EXPECT_TRUE(t.T_mr.Matrix() == o.T_mr.Matrix()) << i;  // before the outage: the same
+    }
+    if (t.imu_residuals > 0) {
+      EXPECT_NE(t.status, ScanStatus::kDegenerate) << i << ": " << t.message;
+      continue;
+    }
+    ASSERT_EQ(t.status, ScanStatus::kDegenerate) << i << ": " << t.message;
+    EXPECT_NE(t.message.find("lidar_frontend.max_correction_without_imu"), std::string::npos);
+    EXPECT_GT(t.correction_m, 1e-4) << i;
+    EXPECT_NE(o.status, ScanStatus::kDegenerate) << i;
+    ++rejected;
+  }
+  EXPECT_GE(rejected, 9);
+  EXPECT_EQ(tight.failed, 0) << tight.first_failure;
+  ASSERT_TRUE(tight.ate.has_value());
+  EXPECT_LT(tight.ate->rmse, 0.5);
+  const OdometryConfig c = OdometryConfigFromYaml(
+      YAML::Load("lidar_frontend:\n  max_correction_without_imu: 0.25\n"), "c.yaml");
+  EXPECT_EQ(c.frontend.max_correction_without_imu, 0.25);
+  EXPECT_EQ(OdometryConfig().frontend.max_correction_without_imu, 0.0);
+  for (const std::string value : {"-1", ".nan", "1001"}) {
+    testing::ExpectError(
+        [value] {
+          OdometryConfigFromYaml(
+              YAML::Load("lidar_frontend:\n  max_correction_without_imu: " + value), "c.yaml");
+        },
+        {"c.yaml", "max_correction_without_imu"});
+  }
+}
+
 // In an outage a scan's degenerate directions keep the prediction (solution remapping, as
 // lidar_only does), outside it the IMU carries them (never remapped). Corridor walk (its axis is
 // degenerate on about half the scans), index 100, 3 s, 16 beams, every 4th firing, no IMU in

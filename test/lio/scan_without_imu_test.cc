@@ -1,9 +1,12 @@
-// ScanWithoutImu (scan_without_imu.h): which scans it applies to, and that a restore after an
-// implausible estimate removes exactly the scan's lidar blocks and puts back the predicted states.
+// ScanWithoutImu (scan_without_imu.h): which scans it applies to, when a correction from the
+// prediction is rejected, and that a restore after an implausible estimate removes exactly the
+// scan's lidar blocks and puts back the predicted states.
 // The larger registration budget is checked through the odometry (imu_dropout_test.cc).
 #include "ctlio/solvers/lio/scan_without_imu.h"
 
 #include <gtest/gtest.h>
+
+#include <string>
 
 #include "ctlio/factors/priors/pose_prior.h"
 #include "ctlio/manifolds/so3.h"
@@ -69,6 +72,35 @@ TEST(ScanWithoutImu, AScanWithImuIsLeftAlone) {
   EXPECT_FALSE(scan.Restore(registered, &window));
   EXPECT_EQ(window.num_residual_blocks(), 1);
   EXPECT_EQ(window.State(2)[0], 9.0);
+}
+
+TEST(ScanWithoutImu, RejectsACorrectionAboveTheLimitOnlyInAnOutageOfAnImuMethod) {
+  SlidingWindow window;
+  window.AddPoseState(2, SE3());
+  ScanWithoutImu scan;
+  scan.Begin(true, {2}, window);
+  ScanResult result;
+  result.status = ScanStatus::kImuGap;
+  result.message = "IMU gap of 2 s";
+  EXPECT_FALSE(scan.RejectsCorrection(true, 0.30, 0.30, &result));   // the limit itself passes
+  EXPECT_FALSE(scan.RejectsCorrection(true, 0.31, 0.0, &result));    // 0 = off
+  EXPECT_FALSE(scan.RejectsCorrection(false, 0.31, 0.30, &result));  // lidar_only
+  EXPECT_EQ(result.status, ScanStatus::kImuGap);
+  ASSERT_TRUE(scan.RejectsCorrection(true, 0.31, 0.30, &result));
+  EXPECT_EQ(result.status, ScanStatus::kDegenerate);
+  EXPECT_NE(result.message.find("0.31 m from the prediction"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("lidar_frontend.max_correction_without_imu"), std::string::npos);
+  EXPECT_NE(result.message.find("IMU gap of 2 s"), std::string::npos);  // the gap's reason kept
+
+  ScanResult failed;
+  failed.status = ScanStatus::kFailed;  // a divergence is reported as such, not as a rejection
+  EXPECT_FALSE(scan.RejectsCorrection(true, 9.0, 0.30, &failed));
+  EXPECT_EQ(failed.status, ScanStatus::kFailed);
+
+  scan.Begin(false, {2}, window);  // a scan with IMU samples
+  ScanResult measured;
+  EXPECT_FALSE(scan.RejectsCorrection(true, 9.0, 0.30, &measured));
+  EXPECT_EQ(measured.status, ScanStatus::kOk);
 }
 
 }  // namespace

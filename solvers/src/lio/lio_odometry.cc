@@ -216,13 +216,16 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   ReportImuGap(estimator_->newest_time(), scan.t_end, result);
   estimator_->AddState(scan, &window_, result);
 
+  // The prediction in the window's parametrisation (T_rm for the GP methods), which the
+  // degeneracy remapping's prior is on, and as the robot's pose in the map (T_mr).
   const SE3 predicted = window_.Pose(estimator_->NewestPoseKey());
+  const SE3 predicted_mr = estimator_->NewestPose();
   without_imu_.Begin(ScanWithoutImu::Applies(config_.method, *result), estimator_->NewestKeys(),
                      window_);
   const std::unique_ptr<LidarTerm> lidar = estimator_->MakeLidarTerm(scan, &window_);
   result->keypoints = static_cast<int>(lidar->num_keypoints());  // a sweep's own budget
   calibration_.Hold(scan.t_end, &window_, result);
-  const double speed = PredictedSpeed(estimator_->PreviousPose(), predicted,
+  const double speed = PredictedSpeed(estimator_->PreviousPose(), predicted_mr,
                                       estimator_->newest_time() - estimator_->previous_time());
   const RegistrationSummary registered =
       RegisterWithin(ScanBudget(config_.frontend, without_imu_.active(), speed), registration_,
@@ -246,11 +249,15 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   const auto t_map = std::chrono::steady_clock::now();
   const size_t kept = std::exchange(map_points_kept_, 0), map_size = map_size_;
   const SE3 T_mr = estimator_->NewestPose();
+  result->correction_m = (T_mr.translation() - predicted_mr.translation()).norm();
   const bool plausible =
       CheckPlausibleJump((T_mr.translation() - estimator_->PreviousPose().translation()).norm(),
                          T_mr.translation().allFinite(), config_.max_scan_translation, result);
-  const bool restored = !plausible && without_imu_.Restore(registered, &window_);
-  if (plausible) {
+  const bool rejected = plausible && without_imu_.RejectsCorrection(
+                                         uses_imu(), result->correction_m,
+                                         config_.frontend.max_correction_without_imu, result);
+  const bool restored = (!plausible || rejected) && without_imu_.Restore(registered, &window_);
+  if (plausible && !rejected) {
     estimator_->MapPoints(scan, &map_points_);
     map_position_ = estimator_->NewestPose().translation();
     map_points_inserted_ = true;

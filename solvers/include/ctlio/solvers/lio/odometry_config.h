@@ -327,6 +327,9 @@ struct ScanResult {
   int associations = 0;  // lidar residuals in the final round
   int imu_residuals = 0;
   int rounds = 0;  // re-association rounds
+  // Translation [m] of the estimate away from the prediction it started from (the GP's
+  // extrapolation or the baseline's preintegration); 0 for the initialising scan.
+  double correction_m = 0.0;
   int solver_iterations = 0;
   double final_cost = 0.0;
   // Whitened χ² (no robust loss) of the IMU terms this scan added, at its final estimate, and

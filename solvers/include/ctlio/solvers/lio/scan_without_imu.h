@@ -9,7 +9,9 @@
 // - if its estimate is implausible, goes back to the prediction: its lidar residuals leave the
 //   window and its states get their starting values again, so that the next scan starts from the
 //   prediction instead of from the diverged pose, which no later scan recovers from (lidar_only,
-//   vlp16 park walk 100: 95 failed scans of 100 after a jump at its third scan).
+//   vlp16 park walk 100: 95 failed scans of 100 after a jump at its third scan);
+// - in an IMU outage of an IMU method, is rejected the same way when the lidar moved it further
+//   from the prediction than LidarFrontendOptions::max_correction_without_imu (RejectsCorrection).
 // Scans with IMU samples are untouched: runs without an outage are the same bit for bit.
 #pragma once
 
@@ -35,6 +37,12 @@ class ScanWithoutImu {
   void Begin(bool applies, const std::vector<StateId>& keys, const SlidingWindow& window);
   // Whether the scan begun last is one.
   bool active() const { return !start_.empty(); }
+
+  // Whether the scan begun last, of a method that `uses_imu`, is rejected for a correction of
+  // `correction` m from its prediction above `limit` (0 = off): then `result` is marked degenerate
+  // with the reason, and the caller restores it (Restore) and leaves its points out of the map.
+  // lidar_only (uses_imu false) has no IMU-predicted motion to fall back on: never rejected.
+  bool RejectsCorrection(bool uses_imu, double correction, double limit, ScanResult* result) const;
 
   // After an implausible estimate: when active(), removes the scan's lidar residuals and restores
   // the starting values; returns whether it did.
