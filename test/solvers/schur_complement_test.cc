@@ -1,9 +1,9 @@
 // Dense marginalisation algebra (solvers/schur_complement.h) against direct inversion.
 #include "ctlio/solvers/schur_complement.h"
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <random>
 
 namespace ctlio {
