@@ -41,7 +41,8 @@ class ScanWithoutImu {
   // Whether the scan begun last, of a method that `uses_imu`, is rejected for a correction of
   // `correction` m from its prediction above `limit` (0 = off): then `result` is marked degenerate
   // with the reason, and the caller restores it (Restore) and leaves its points out of the map.
-  // lidar_only (uses_imu false) has no IMU-predicted motion to fall back on: never rejected.
+  // Never for lidar_only (uses_imu false): every one of its scans is one, and its prediction never
+  // had the IMU's motion behind it (not measured for it: docs/experiments/imu-dropout.md).
   bool RejectsCorrection(bool uses_imu, double correction, double limit, ScanResult* result) const;
 
   // After an implausible estimate: when active(), removes the scan's lidar residuals and restores
