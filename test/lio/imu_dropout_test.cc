@@ -30,6 +30,11 @@ sim::SimConfig SequenceWithOutage() {
   return c;
 }
 
+// A call that reads `yaml` as a user's file c.yaml, for testing::ExpectError.
+auto ReadsConfig(const std::string& yaml) {
+  return [yaml] { OdometryConfigFromYaml(YAML::Load(yaml), "c.yaml"); };
+}
+
 OdometryConfig Config(LioMethod method) {
   OdometryConfig c = testing::SimLioConfig();
   c.method = method;
@@ -165,12 +170,9 @@ TEST(ImuDropout, BudgetWithoutImuIsReadAndChecked) {
   EXPECT_EQ(c.frontend.solver_iterations_without_imu, 4);
   EXPECT_EQ(OdometryConfig().frontend.max_iterations_without_imu, 10);
   EXPECT_EQ(OdometryConfig().frontend.solver_iterations_without_imu, 5);
-  const auto read = [](const std::string& yaml) {
-    return [yaml] { OdometryConfigFromYaml(YAML::Load(yaml), "c.yaml"); };
-  };
-  testing::ExpectError(read("lidar_frontend:\n  max_iterations_without_imu: -1\n"),
+  testing::ExpectError(ReadsConfig("lidar_frontend:\n  max_iterations_without_imu: -1\n"),
                        {"max_iterations_without_imu"});
-  testing::ExpectError(read("lidar_frontend:\n  solver_iterations_without_imu: 1001\n"),
+  testing::ExpectError(ReadsConfig("lidar_frontend:\n  solver_iterations_without_imu: 1001\n"),
                        {"solver_iterations_without_imu"});
 }
 
@@ -220,12 +222,8 @@ TEST(ImuDropout, ACorrectionBeyondTheLimitInAnOutageKeepsThePrediction) {
   EXPECT_EQ(c.frontend.max_correction_without_imu, 0.25);
   EXPECT_EQ(OdometryConfig().frontend.max_correction_without_imu, 0.0);
   for (const std::string value : {"-1", ".nan", "1001"}) {
-    testing::ExpectError(
-        [value] {
-          OdometryConfigFromYaml(
-              YAML::Load("lidar_frontend:\n  max_correction_without_imu: " + value), "c.yaml");
-        },
-        {"c.yaml", "max_correction_without_imu"});
+    testing::ExpectError(ReadsConfig("lidar_frontend:\n  max_correction_without_imu: " + value),
+                         {"c.yaml", "max_correction_without_imu"});
   }
 }
 
