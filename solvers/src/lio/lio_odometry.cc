@@ -259,7 +259,7 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   const bool restored = (!plausible || rejected) && without_imu_.Restore(registered, &window_);
   if (plausible && !rejected) {
     estimator_->MapPoints(scan, &map_points_);
-    map_position_ = estimator_->NewestPose().translation();
+    map_position_ = T_mr.translation();
     map_points_inserted_ = true;
     if (config_.overlap_stages) {
       // Inserted on a second thread from now on: in real time, while the robot waits for the
