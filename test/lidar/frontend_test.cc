@@ -180,6 +180,55 @@ TEST(Frontend, LineNeighbourhoodIsFittedAcrossToTheNextRing) {
   EXPECT_EQ(line.weight, across.weight);
 }
 
+// max_plane_thickness: a tree crown is a sphere (here R = 2 m, sampled every 0.1 m and thinned by
+// the map as a sweep's points are). The kNN plane through a patch of it is a chord, so a point of
+// the surface lies outside that plane (on the side away from the centre, towards the sensor that
+// sees it) by about a²/4R: registering a sweep whose points are that surface's own pulls each of
+// them inwards. Its planarity weight is of the order of a noisy wall's, so only the thickness σ3
+// tells them apart: a gate between the two (a wall with ±1.5 cm of range noise, σ3 ≈ 1.1 cm here;
+// the crown patch ≈ 2.6 cm) rejects the crown and leaves the wall's association as it was.
+TEST(Frontend, ThickNeighbourhoodIsNoPlane) {
+  LidarFrontendOptions off;
+  LidarFrontendOptions on;
+  on.max_plane_thickness = 0.02;
+  const Vec3 q(1.0, 2.0, 3.0);
+  // The wall x = 20 seen at range, ±1.5 cm of noise along its normal.
+  VoxelMap wall(LidarFrontend::MapOptions(off));
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.015);
+  for (double y = -3; y <= 3; y += 0.1)
+    for (double z = 0; z <= 6; z += 0.1) wall.Insert(Vec3(20.0 + noise(rng), y, z));
+  const Vec3 on_wall(20.0, 0.3, 2.0);
+  PlaneAssociation with, without;
+  ASSERT_TRUE(PlaneAssociator(wall, off).Associate(q, on_wall, &without));
+  ASSERT_TRUE(PlaneAssociator(wall, on).Associate(q, on_wall, &with));
+  EXPECT_EQ(with.plane_point, without.plane_point);
+  EXPECT_EQ(with.weight, without.weight);
+  EXPECT_GT(std::abs(with.plane_normal.x()), 0.99);
+  // The crown.
+  const Vec3 centre(20.0, 0.0, 4.0);
+  const double radius = 2.0;
+  VoxelMap crown(LidarFrontend::MapOptions(off));
+  for (double theta = 0.05; theta < M_PI; theta += 0.1 / radius) {
+    const int n = std::max(1, int(std::round(2 * M_PI * radius * std::sin(theta) / 0.1)));
+    for (int k = 0; k < n; ++k) {
+      const double phi = 2 * M_PI * k / n;
+      crown.Insert(centre + radius * Vec3(std::sin(theta) * std::cos(phi),
+                                          std::sin(theta) * std::sin(phi), std::cos(theta)));
+    }
+  }
+  const Vec3 outward = Vec3(-1.0, 0.2, 0.1).normalized();
+  const Vec3 surface = centre + radius * outward;
+  PlaneAssociation a;
+  ASSERT_TRUE(PlaneAssociator(crown, off).Associate(q, surface, &a));
+  EXPECT_GT(a.weight, 0.5 * without.weight);
+  const double side = a.plane_normal.dot(outward) > 0 ? 1.0 : -1.0;
+  const double outside = side * a.plane_normal.dot(surface - a.plane_point);
+  EXPECT_GT(outside, 0.02) << "the crown's own point should lie outside its chord plane";
+  EXPECT_LT(outside, 0.5);
+  EXPECT_FALSE(PlaneAssociator(crown, on).Associate(q, surface, &a));
+}
+
 // The voxel-plane association answers from the map's per-voxel plane where the voxel holds
 // min_neighbours points, and falls back to the kNN plane where it does not.
 TEST(Frontend, VoxelPlaneAssociationAndFallback) {
@@ -443,6 +492,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.voxel_plane_max_thickness, d.voxel_plane_max_thickness);
   EXPECT_EQ(o.line_neighbourhood_ratio, 0.0);
   EXPECT_EQ(o.line_neighbourhood_ratio, d.line_neighbourhood_ratio);
+  EXPECT_EQ(o.max_plane_thickness, 0.0);
+  EXPECT_EQ(o.max_plane_thickness, d.max_plane_thickness);
   EXPECT_EQ(o.threads, 1);
   EXPECT_EQ(o.threads, d.threads);
 }
@@ -476,6 +527,11 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_EQ(LidarFrontendOptionsFromYaml(YAML::Load("line_neighbourhood_ratio: 0.1\n"))
                 .line_neighbourhood_ratio,
             0.1);
+  EXPECT_NE(ErrorOf("max_plane_thickness: -0.01\n").find("max_plane_thickness"), std::string::npos);
+  EXPECT_NE(ErrorOf("max_plane_thickness: .nan\n").find("max_plane_thickness"), std::string::npos);
+  EXPECT_EQ(
+      LidarFrontendOptionsFromYaml(YAML::Load("max_plane_thickness: 0.05\n")).max_plane_thickness,
+      0.05);
   EXPECT_NE(ErrorOf("reassociation_distance: -0.1\n").find("reassociation_distance"),
             std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);

@@ -311,6 +311,9 @@ bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
         !FitAcrossLine(p_map, &knn_plane)) {
       return false;
     }
+    if (options_.max_plane_thickness > 0.0 && knn_plane.sigma3 > options_.max_plane_thickness) {
+      return false;
+    }
   }
   const PlaneFit& plane = *fit;
   const double distance = std::abs(plane.normal.dot(p_map - plane.centroid));

@@ -40,6 +40,7 @@ void LidarFrontendOptions::Validate() const {
   require(association == "knn" || association == "voxel_plane",
           "association must be knn or voxel_plane");
   require(voxel_plane_max_thickness >= 0.0, "voxel_plane_max_thickness must be >= 0");
+  require(max_plane_thickness >= 0.0, "max_plane_thickness must be >= 0 (0 = off)");
   require(line_neighbourhood_ratio >= 0.0 && line_neighbourhood_ratio <= 0.99,
           "line_neighbourhood_ratio must be in [0, 0.99] (0 = off)");
   require(threads >= 1 && threads <= kMaxConfigThreads, "threads must be in [1, 256]");
@@ -101,6 +102,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"max_plane_distance", SetFromYaml(&o.max_plane_distance)},
       {"association", SetFromYaml(&o.association)},
       {"voxel_plane_max_thickness", SetFromYaml(&o.voxel_plane_max_thickness)},
+      {"max_plane_thickness", SetFromYaml(&o.max_plane_thickness)},
       {"line_neighbourhood_ratio", SetInRange(&o.line_neighbourhood_ratio, 0.0, 0.99, source,
                                               "lidar_frontend.line_neighbourhood_ratio")},
       {"threads", SetInRange(&o.threads, 1, kMaxConfigThreads, source, "lidar_frontend.threads")},

@@ -55,6 +55,13 @@ struct LidarFrontendOptions {
   // the same surface; a neighbourhood still a line after that gives no association. 0 = off (the
   // kNN plane as it is). docs/experiments/covariance.md, "16 beams".
   double line_neighbourhood_ratio = 0.0;
+  // A kNN plane thicker than this (σ3, the RMS distance of its neighbours from it) is no plane:
+  // foliage (returns scattered through a crown's depth, from where each beam enters, which moves
+  // with the viewpoint) or a convex surface (a trunk, a pole, whose fitted plane is a chord that
+  // the surface's own points lie outside of by ~a²/4R for a patch of radius a). Planarity weights
+  // keep such patches near a wall's weight. 0 = off; measured, not shipped
+  // (docs/experiments/scoreboard.md, "Foliage and convex surfaces").
+  double max_plane_thickness = 0.0;  // m
   // voxel_plane only: a voxel's plane is used when its thickness σ3 (the smallest standard
   // deviation of its points) is at most this, else the kNN plane (a voxel across an edge or a
   // corner is no plane, while the nearest points on one face are).
