@@ -313,6 +313,8 @@ TEST(FrontendOptions, ShippedYamlHasTheDocumentedDefaults) {
   EXPECT_EQ(o.line_neighbourhood_ratio, d.line_neighbourhood_ratio);
   EXPECT_EQ(o.max_plane_thickness, 0.0);
   EXPECT_EQ(o.max_plane_thickness, d.max_plane_thickness);
+  EXPECT_EQ(o.plane_thickness_noise, 0.0);
+  EXPECT_EQ(o.plane_thickness_noise, d.plane_thickness_noise);
   EXPECT_EQ(o.threads, 1);
   EXPECT_EQ(o.threads, d.threads);
 }
@@ -351,6 +353,13 @@ TEST(FrontendOptions, BadInputNamesFileAndLine) {
   EXPECT_EQ(
       LidarFrontendOptionsFromYaml(YAML::Load("max_plane_thickness: 0.05\n")).max_plane_thickness,
       0.05);
+  EXPECT_NE(ErrorOf("plane_thickness_noise: -1\n").find("plane_thickness_noise"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("plane_thickness_noise: .nan\n").find("plane_thickness_noise"),
+            std::string::npos);
+  EXPECT_EQ(
+      LidarFrontendOptionsFromYaml(YAML::Load("plane_thickness_noise: 2\n")).plane_thickness_noise,
+      2.0);
   EXPECT_NE(ErrorOf("reassociation_distance: -0.1\n").find("reassociation_distance"),
             std::string::npos);
   EXPECT_NE(ErrorOf("[1, 2]\n").find("mapping"), std::string::npos);

@@ -102,7 +102,10 @@ TEST(Frontend, ThickNeighbourhoodIsNoPlane) {
     for (double z = 0; z <= 6; z += 0.1) wall.Insert(Vec3(20.0 + noise(rng), y, z));
   const Vec3 on_wall(20.0, 0.3, 2.0);
   PlaneAssociation with, without;
-  ASSERT_TRUE(PlaneAssociator(wall, off).Associate(q, on_wall, &without));
+  double wall_thickness = -1.0;
+  ASSERT_TRUE(PlaneAssociator(wall, off).Associate(q, on_wall, &without, &wall_thickness));
+  EXPECT_GT(wall_thickness, 0.005);  // the range noise along the wall's normal, σ 1.5 cm
+  EXPECT_LT(wall_thickness, 0.02);
   ASSERT_TRUE(PlaneAssociator(wall, on).Associate(q, on_wall, &with));
   EXPECT_EQ(with.plane_point, without.plane_point);
   EXPECT_EQ(with.weight, without.weight);
@@ -122,7 +125,10 @@ TEST(Frontend, ThickNeighbourhoodIsNoPlane) {
   const Vec3 outward = Vec3(-1.0, 0.2, 0.1).normalized();
   const Vec3 surface = centre + radius * outward;
   PlaneAssociation a;
-  ASSERT_TRUE(PlaneAssociator(crown, off).Associate(q, surface, &a));
+  double crown_thickness = -1.0;
+  ASSERT_TRUE(PlaneAssociator(crown, off).Associate(q, surface, &a, &crown_thickness));
+  EXPECT_GT(crown_thickness, 0.02);
+  EXPECT_GT(crown_thickness, 2.0 * wall_thickness);
   EXPECT_GT(a.weight, 0.5 * without.weight);
   const double side = a.plane_normal.dot(outward) > 0 ? 1.0 : -1.0;
   const double outside = side * a.plane_normal.dot(surface - a.plane_point);

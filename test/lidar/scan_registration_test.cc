@@ -329,6 +329,21 @@ TEST(ScanRegistration, PointNoiseSigmaGrowsWithRange) {
               1e-15);
 }
 
+// plane_thickness_noise: the plane's own scatter σ3 (times the factor) adds to σ_i in quadrature;
+// without the factor the thickness is not used.
+TEST(ScanRegistration, PointNoiseSigmaGrowsWithThePlanesThickness) {
+  LidarFrontendOptions o;
+  o.point_noise_sigma = 0.05;
+  EXPECT_EQ(PointNoiseSigma(o, Vec3(30.0, 0.0, 0.0), 0.08), 0.05);
+  o.plane_thickness_noise = 2.0;
+  EXPECT_NEAR(PointNoiseSigma(o, Vec3(30.0, 0.0, 0.0), 0.03), std::sqrt(0.05 * 0.05 + 0.06 * 0.06),
+              1e-15);
+  EXPECT_EQ(PointNoiseSigma(o, Vec3(30.0, 0.0, 0.0), 0.0), 0.05);
+  o.point_noise_angle = 0.004;
+  EXPECT_NEAR(PointNoiseSigma(o, Vec3(0.0, 6.0, 8.0), 0.015),
+              std::sqrt(0.05 * 0.05 + 0.04 * 0.04 + 0.03 * 0.03), 1e-15);
+}
+
 // A term that records the (whitened) association of every residual it is given.
 class RecordingTerm final : public LidarTerm {
  public:

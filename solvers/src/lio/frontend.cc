@@ -296,7 +296,7 @@ PlaneAssociator::PlaneAssociator(const VoxelMap& map, const LidarFrontendOptions
 }
 
 bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
-                                PlaneAssociation* association) {
+                                PlaneAssociation* association, double* thickness) {
   PlaneFit knn_plane;
   const PlaneFit* fit = &knn_plane;
   const VoxelPlane* voxel = voxel_planes_ ? map_.PlaneOf(p_map) : nullptr;
@@ -322,6 +322,7 @@ bool PlaneAssociator::Associate(const Vec3& q_robot, const Vec3& p_map,
   association->plane_point = plane.centroid;
   association->plane_normal = plane.normal;
   association->weight = plane.planarity_weight;
+  if (thickness != nullptr) *thickness = plane.sigma3;
   return true;
 }
 

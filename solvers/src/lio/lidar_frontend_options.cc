@@ -41,6 +41,8 @@ void LidarFrontendOptions::Validate() const {
           "association must be knn or voxel_plane");
   require(voxel_plane_max_thickness >= 0.0, "voxel_plane_max_thickness must be >= 0");
   require(max_plane_thickness >= 0.0, "max_plane_thickness must be >= 0 (0 = off)");
+  require(plane_thickness_noise >= 0.0 && plane_thickness_noise <= 100.0,
+          "plane_thickness_noise must be in [0, 100] (0 = off)");
   require(line_neighbourhood_ratio >= 0.0 && line_neighbourhood_ratio <= 0.99,
           "line_neighbourhood_ratio must be in [0, 0.99] (0 = off)");
   require(threads >= 1 && threads <= kMaxConfigThreads, "threads must be in [1, 256]");
@@ -103,6 +105,8 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"association", SetFromYaml(&o.association)},
       {"voxel_plane_max_thickness", SetFromYaml(&o.voxel_plane_max_thickness)},
       {"max_plane_thickness", SetFromYaml(&o.max_plane_thickness)},
+      {"plane_thickness_noise", SetInRange(&o.plane_thickness_noise, 0.0, 100.0, source,
+                                           "lidar_frontend.plane_thickness_noise")},
       {"line_neighbourhood_ratio", SetInRange(&o.line_neighbourhood_ratio, 0.0, 0.99, source,
                                               "lidar_frontend.line_neighbourhood_ratio")},
       {"threads", SetInRange(&o.threads, 1, kMaxConfigThreads, source, "lidar_frontend.threads")},

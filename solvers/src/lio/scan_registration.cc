@@ -17,10 +17,12 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
-double PointNoiseSigma(const LidarFrontendOptions& o, const Vec3& q_robot) {
-  if (!(o.point_noise_angle > 0.0)) return o.point_noise_sigma;
+double PointNoiseSigma(const LidarFrontendOptions& o, const Vec3& q_robot, double plane_thickness) {
+  const double scatter = o.plane_thickness_noise * plane_thickness;
+  if (!(o.point_noise_angle > 0.0) && !(scatter > 0.0)) return o.point_noise_sigma;
   const double angular = o.point_noise_angle * q_robot.norm();
-  return std::sqrt(o.point_noise_sigma * o.point_noise_sigma + angular * angular);
+  return std::sqrt(o.point_noise_sigma * o.point_noise_sigma + angular * angular +
+                   scatter * scatter);
 }
 
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& o) {
@@ -58,6 +60,7 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
   // Per keypoint: the plane of its last search (weight not whitened), whether that search found
   // one, and where the keypoint was in the map then.
   std::vector<PlaneAssociation> planes(n);
+  std::vector<double> thickness(n, 0.0);
   std::vector<uint8_t> associated(n, 0);
   std::vector<Vec3> searched_at(n);
   // Per keypoint: its residual in the window (nullptr: none).
@@ -99,13 +102,13 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
           continue;
         }
         searched_at[i] = p_map[i];
-        associated[i] = associator.Associate(q[i], p_map[i], &planes[i]) ? 1 : 0;
+        associated[i] = associator.Associate(q[i], p_map[i], &planes[i], &thickness[i]) ? 1 : 0;
       }
     });
     // This round's residuals replace the previous round's, on the whitened planes.
     const auto whiten = [&](size_t i) {
       PlaneAssociation a = planes[i];
-      a.weight /= PointNoiseSigma(options_, a.point_robot);
+      a.weight /= PointNoiseSigma(options_, a.point_robot, thickness[i]);
       return a;
     };
     int associations = 0;

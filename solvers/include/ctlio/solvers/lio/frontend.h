@@ -61,8 +61,10 @@ class PlaneAssociator {
   // alone); "voxel_plane": the plane kept by the map for p_map's voxel when it holds ≥
   // min_neighbours points and is at most voxel_plane_max_thickness thick, else the kNN plane. Fills
   // *association (weight = the planarity weight) and returns true on success. Reads the map only:
-  // one associator per thread.
-  bool Associate(const Vec3& q_robot, const Vec3& p_map, PlaneAssociation* association);
+  // one associator per thread. *thickness (when given): the plane's σ3, the RMS distance of the
+  // points it was fitted to from it.
+  bool Associate(const Vec3& q_robot, const Vec3& p_map, PlaneAssociation* association,
+                 double* thickness = nullptr);
 
  private:
   // The plane of the map points around p_map across the line its k nearest neighbours

@@ -62,6 +62,12 @@ struct LidarFrontendOptions {
   // keep such patches near a wall's weight. 0 = off; measured, not shipped
   // (docs/experiments/scoreboard.md, "Foliage and convex surfaces").
   double max_plane_thickness = 0.0;  // m
+  // The plane's own scatter in the residual's σ: a keypoint's σ² gains (plane_thickness_noise ·
+  // σ3)², σ3 the thickness of the plane it is associated with, so a point on foliage or a convex
+  // patch weighs less than one on a wall, and none is dropped (the gate above drops them, which
+  // leaves a stretch seeing mostly hedges and crowns too few planes). 0 = off; 1 in five sensor
+  // files, off for the VLP-16, whose yaw drifts where hedges line a street (scoreboard.md).
+  double plane_thickness_noise = 0.0;
   // voxel_plane only: a voxel's plane is used when its thickness σ3 (the smallest standard
   // deviation of its points) is at most this, else the kNN plane (a voxel across an edge or a
   // corner is no plane, while the nearest points on one face are).

@@ -95,9 +95,11 @@ struct RegistrationSummary {
 // "none".
 std::unique_ptr<ceres::LossFunction> MakeLidarLoss(const LidarFrontendOptions& options);
 
-// The σ that whitens the residual of a keypoint at q_robot (robot frame):
-// √(point_noise_sigma² + (point_noise_angle·|q_robot|)²); point_noise_sigma when the angle is 0.
-double PointNoiseSigma(const LidarFrontendOptions& options, const Vec3& q_robot);
+// The σ that whitens the residual of a keypoint at q_robot (robot frame) against a plane of
+// thickness σ3 = plane_thickness: √(point_noise_sigma² + (point_noise_angle·|q_robot|)² +
+// (plane_thickness_noise·σ3)²); point_noise_sigma when the angle and the factor are 0.
+double PointNoiseSigma(const LidarFrontendOptions& options, const Vec3& q_robot,
+                       double plane_thickness = 0.0);
 
 class ScanRegistration {
  public:
