@@ -2,15 +2,19 @@
 // each loads through its base, carries its sensor's IMU rate and a noise no lower than its own,
 // the driver's accelerometer unit, and an extrinsic exactly where the device fixes one (Ouster,
 // Livox): never for an external IMU (Velodyne, Hesai), whose recording's /tf_static a config
-// extrinsic would silently override.
+// extrinsic would silently override; where a file weighs planes by their thickness, foliage
+// weighs less than a wall.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <random>
 
 #include "common/test_paths.h"
 #include "ctlio/sim/sensor_models.h"
+#include "ctlio/solvers/lio/frontend.h"
 #include "ctlio/solvers/lio/odometry_config.h"
+#include "ctlio/solvers/lio/scan_registration.h"
 
 namespace ctlio::lio {
 namespace {
@@ -40,6 +44,39 @@ TEST(SensorConfigs, OnePerModelWithItsImuAndExtrinsic) {
       EXPECT_LT((c.T_imu_lidar.Matrix() - m.imu_from_lidar.Matrix()).norm(), 1e-12);
     }
   }
+}
+
+// lidar_frontend.plane_thickness_noise where a file sets it: a wall seen with the sensor's range
+// noise keeps at least 90 % of its residual's weight, a crown's foliage (returns scattered
+// through its depth: points filling a 2 m ball) gets less than half a wall's.
+TEST(SensorConfigs, ThicknessWeightTellsFoliageFromAWall) {
+  int files_with_it = 0;
+  for (const sim::SensorModel& m : sim::SensorModels()) {
+    SCOPED_TRACE(m.name);
+    const LidarFrontendOptions o = LoadOdometryConfig(kDir + m.name + ".yaml").frontend;
+    if (o.plane_thickness_noise == 0.0) continue;
+    ++files_with_it;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> noise(0.0, m.lidar.range_noise);
+    VoxelMap wall(LidarFrontend::MapOptions(o));
+    for (double y = -3; y <= 3; y += 0.1)
+      for (double z = 0; z <= 6; z += 0.1) wall.Insert(Vec3(20.0 + noise(rng), y, z));
+    std::uniform_real_distribution<double> u(-2.0, 2.0);
+    VoxelMap crown(LidarFrontend::MapOptions(o));
+    for (int k = 0; k < 4000; ++k) {
+      const Vec3 d(u(rng), u(rng), u(rng));
+      if (d.norm() <= 2.0) crown.Insert(Vec3(20.0, 0.0, 4.0) + d);
+    }
+    const Vec3 q(20.0, 0.3, 2.0);
+    PlaneAssociation a;
+    double t_wall = 0.0, t_crown = 0.0;
+    ASSERT_TRUE(PlaneAssociator(wall, o).Associate(q, q, &a, &t_wall));
+    ASSERT_TRUE(PlaneAssociator(crown, o).Associate(q, Vec3(20.0, 0.0, 4.0), &a, &t_crown));
+    const double sigma = PointNoiseSigma(o, q);
+    EXPECT_GT(sigma / PointNoiseSigma(o, q, t_wall), 0.9);
+    EXPECT_LT(sigma / PointNoiseSigma(o, q, t_crown), 0.5 * sigma / PointNoiseSigma(o, q, t_wall));
+  }
+  EXPECT_GE(files_with_it, 1);
 }
 
 }  // namespace
