@@ -53,9 +53,17 @@ TEST(SensorConfigs, ThicknessWeightTellsFoliageFromAWall) {
   int files_with_it = 0;
   for (const sim::SensorModel& m : sim::SensorModels()) {
     SCOPED_TRACE(m.name);
-    const LidarFrontendOptions o = LoadOdometryConfig(kDir + m.name + ".yaml").frontend;
+    const OdometryConfig c = LoadOdometryConfig(kDir + m.name + ".yaml");
+    const LidarFrontendOptions o = c.frontend;
     if (o.plane_thickness_noise == 0.0) continue;
     ++files_with_it;
+    // Tuned for the two IMU methods; the lidar-only registrations keep every plane at full
+    // weight, and the file's per-method keys leave the base's (the baseline's budget) in place.
+    EXPECT_EQ(c.ForMethod(LioMethod::kImuInput).frontend.plane_thickness_noise,
+              o.plane_thickness_noise);
+    EXPECT_EQ(c.ForMethod(LioMethod::kImuInput).frontend.max_iterations, 4);
+    EXPECT_EQ(c.ForMethod(LioMethod::kLidarOnly).frontend.plane_thickness_noise, 0.0);
+    EXPECT_EQ(c.ForMethod(LioMethod::kLidarGyro).frontend.plane_thickness_noise, 0.0);
     std::mt19937 rng(3);
     std::normal_distribution<double> noise(0.0, m.lidar.range_noise);
     VoxelMap wall(LidarFrontend::MapOptions(o));
