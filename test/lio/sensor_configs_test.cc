@@ -57,8 +57,8 @@ TEST(SensorConfigs, ThicknessWeightTellsFoliageFromAWall) {
     const LidarFrontendOptions o = c.frontend;
     if (o.plane_thickness_noise == 0.0) continue;
     ++files_with_it;
-    // Tuned for the two IMU methods; the lidar-only registrations keep every plane at full
-    // weight, and the file's per-method keys leave the base's (the baseline's budget) in place.
+    // Tuned for the two IMU methods; the lidar-only registrations keep every plane at full weight
+    // (base.yaml's per_method), beside the baseline's own budget there.
     EXPECT_EQ(c.ForMethod(LioMethod::kImuInput).frontend.plane_thickness_noise,
               o.plane_thickness_noise);
     EXPECT_EQ(c.ForMethod(LioMethod::kImuInput).frontend.max_iterations, 4);
