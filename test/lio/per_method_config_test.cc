@@ -122,8 +122,8 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   const OdometryConfig v =
       LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sensors/vlp16.yaml");
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.0007);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_m, 0.003);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.00065);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_m, 0.001);
   EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
   // The model's misfit (misfit_covariance.h): Singer-LIO's on the VLP-16, off by default.
   EXPECT_TRUE(v.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
@@ -131,9 +131,9 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   EXPECT_TRUE(c.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
   EXPECT_FALSE(OdometryConfig().pose_covariance_misfit);
   // The line-neighbourhood plane fit is both methods' (vlp16.yaml's lidar_frontend).
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.line_neighbourhood_ratio, 0.1);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.1);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.0015);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.line_neighbourhood_ratio, 0.3);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.3);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.0012);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_m, 0.008);
   const OdometryConfig nc =
       LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/newer_college_lio.yaml");
