@@ -369,7 +369,8 @@ class RecordingTerm final : public LidarTerm {
 
 // In the registration each residual is whitened by its keypoint's own σ: the residual of a
 // keypoint 10 m away weighs less than one 4 m away, by the ratio of their σ, while without the
-// angle every keypoint has the configured σ; the room is registered either way.
+// angle every keypoint has the configured σ; the room is registered either way. The summary
+// reports each keypoint's σ (what the adaptive covariance whitens its residual by).
 TEST(ScanRegistration, FarKeypointsAreWhitenedByTheirRangeDependentSigma) {
   const Scene s = MakeScene(44, 300);
   for (const double angle : {0.0, 0.005}) {
@@ -385,13 +386,18 @@ TEST(ScanRegistration, FarKeypointsAreWhitenedByTheirRangeDependentSigma) {
     ASSERT_FALSE(summary.degenerate);
     EXPECT_GT(summary.associations, 250);
     int near = 0, far = 0;
+    ASSERT_EQ(summary.noise_sigma.size(), s.keypoints.size());
     for (size_t i = 0; i < s.keypoints.size(); ++i) {
-      if (!summary.associated[i]) continue;
+      if (!summary.associated[i]) {
+        EXPECT_EQ(summary.noise_sigma[i], 0.0) << i;
+        continue;
+      }
       const PlaneAssociation& whitened = term.last.at(i);
       const PlaneAssociation& plane = summary.planes[i];
       const double range = plane.point_robot.norm();
       const double sigma = std::sqrt(0.03 * 0.03 + angle * range * angle * range);
       EXPECT_NEAR(whitened.weight * sigma, plane.weight, 1e-12 * plane.weight) << i;
+      EXPECT_NEAR(summary.noise_sigma[i], sigma, 1e-12 * sigma) << i;
       near += range < 5.0;
       far += range > 8.0;
     }

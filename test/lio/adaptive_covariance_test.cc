@@ -46,6 +46,35 @@ TEST(LidarSpread, SeparatesThePointNoiseFromThePlaneSharedError) {
   EXPECT_LT(t.effective_variance(), 0.5 * s.effective_variance());
 }
 
+// Residuals of two kinds, σ 1 cm and 4 cm (near points on thin planes, far ones or thick
+// planes), each drawn with its own σ: in units of each residual's own variance the lidar's
+// spread is 1 (×n_eff); measured against the 1 cm alone it reads ~3× (the mixture's MAD
+// variance: the median |e| is 1.16 cm), which would make the covariance that much too
+// pessimistic for every residual, the near ones on thin planes included.
+TEST(LidarVarianceFactor, IsInUnitsOfEachResidualsOwnVariance) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n;
+  std::vector<double> e, sigma, nominal;
+  std::vector<Vec3> at;
+  for (int i = 0; i < 2000; ++i) {
+    const double s = i % 2 == 0 ? 0.01 : 0.04;
+    e.push_back(s * n(rng));
+    sigma.push_back(s);
+    nominal.push_back(0.01);
+    at.push_back(Vec3(2.0 * i, 0.5, 0.5));  // each in its own cell
+  }
+  // The MAD variance of 2000 standard normals: relative σ ≈ 8 %; bound 3σ.
+  EXPECT_NEAR(LidarVarianceFactor(e, sigma, at, 1.0), 1.0, 0.25);
+  EXPECT_NEAR(LidarVarianceFactor(e, sigma, at, 10.0), 10.0, 2.5);
+  EXPECT_GT(LidarVarianceFactor(e, nominal, at, 1.0), 2.5);
+  // One σ for all: the spread in metres over σ², as before there were several.
+  const double one = LidarVarianceFactor(e, nominal, at, 3.0);
+  EXPECT_NEAR(one, 3.0 * MeasureLidarSpread(e, at, kLidarPlaneCell).effective_variance() / 1e-4,
+              1e-12 * one);
+  EXPECT_THROW(LidarVarianceFactor(e, std::vector<double>(3, 0.01), at, 1.0),
+               std::invalid_argument);
+}
+
 // One pose under two Gaussian "groups" and a "prior": Σ = (Σ_g P_g⁻¹/s_g)⁻¹ exactly.
 TEST(GroupScaledPoseCovariance, IsTheScaledInformationInverted) {
   const SE3 T = FarPose();

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 namespace ctlio::lio {
 
@@ -191,6 +192,16 @@ std::optional<Mat6> AdaptiveNoiseScales::Compute(SlidingWindow* window, StateId 
   prior_ = Smooth(prior_, s_prior, first_);
   first_ = false;
   return c->scaled;
+}
+
+double LidarVarianceFactor(const std::vector<double>& residuals, const std::vector<double>& sigmas,
+                           const std::vector<Vec3>& plane_points, double neff) {
+  if (sigmas.size() != residuals.size() || plane_points.size() != residuals.size()) {
+    throw std::invalid_argument("LidarVarianceFactor: one σ and one plane point per residual");
+  }
+  std::vector<double> whitened(residuals.size());
+  for (size_t i = 0; i < residuals.size(); ++i) whitened[i] = residuals[i] / sigmas[i];
+  return neff * MeasureLidarSpread(whitened, plane_points, kLidarPlaneCell).effective_variance();
 }
 
 }  // namespace ctlio::lio

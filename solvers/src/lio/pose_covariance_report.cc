@@ -77,7 +77,7 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
     if (!registered.associated.empty()) {
       // The residuals at the estimate, in metres (the window's are whitened, and a batched
       // term's rows are not per keypoint).
-      std::vector<double> e;
+      std::vector<double> e, sigma;
       std::vector<Vec3> at;
       term->BeginRound();
       for (size_t i = 0; i < registered.associated.size(); ++i) {
@@ -86,12 +86,10 @@ std::optional<Mat6> NewestPoseCovariance(const OdometryConfig& config,
         Vec3 q, p_map;
         term->Locate(i, &q, &p_map);
         e.push_back(a.weight * a.plane_normal.dot(p_map - a.plane_point));
+        sigma.push_back(registered.noise_sigma[i]);
         at.push_back(a.plane_point);
       }
-      const LidarSpread spread = MeasureLidarSpread(e, at, kLidarPlaneCell);
-      const double sigma = config.frontend.point_noise_sigma;
-      lidar_estimate =
-          config.pose_covariance_lidar_neff * spread.effective_variance() / (sigma * sigma);
+      lidar_estimate = LidarVarianceFactor(e, sigma, at, config.pose_covariance_lidar_neff);
     }
     const std::optional<Mat6> S =
         models->adaptive.Compute(window, pose, lidar_estimate, lidar, imu.accel, imu.gyro,

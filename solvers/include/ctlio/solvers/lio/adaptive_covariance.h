@@ -68,6 +68,15 @@ inline constexpr double kLidarPlaneCell = 1.0;
 LidarSpread MeasureLidarSpread(const std::vector<double>& residuals,
                                const std::vector<Vec3>& plane_points, double cell);
 
+// The lidar term's variance in the adaptive covariance, as the multiple of each residual's own
+// configured variance that its blocks are divided by: the residuals e_i [m] whitened by the σ_i
+// the window whitened them with (PointNoiseSigma: point noise, range-grown angle, plane
+// thickness), their spread's effective variance (MeasureLidarSpread, cell kLidarPlaneCell) times
+// n_eff. Whitening each residual by its own σ_i, not one nominal σ, keeps residuals the window
+// already weighs less (far points, thick planes) from inflating every residual's variance.
+double LidarVarianceFactor(const std::vector<double>& residuals, const std::vector<double>& sigmas,
+                           const std::vector<Vec3>& plane_points, double neff);
+
 // One group of residual blocks whose information the covariance divides by `scale`.
 struct ScaledGroup {
   std::vector<ceres::ResidualBlockId> blocks;

@@ -88,6 +88,9 @@ struct RegistrationSummary {
   // degenerate): what the residuals measure, e.g. for their spread (adaptive_covariance.h).
   std::vector<PlaneAssociation> planes;
   std::vector<uint8_t> associated;
+  // Each keypoint's σ in the last round, the one its residual was whitened by (PointNoiseSigma;
+  // 0 where it has no plane).
+  std::vector<double> noise_sigma;
 };
 
 // The robust loss of the point-to-plane residuals (cauchy/huber/none, SPEC §4): the residuals
