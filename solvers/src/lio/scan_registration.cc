@@ -175,8 +175,8 @@ RegistrationSummary ScanRegistration::Register(const VoxelMap& map, LidarTerm* t
   if (!summary.degenerate) {
     summary.noise_sigma.assign(n, 0.0);
     for (size_t i = 0; i < n; ++i) {
-      if (associated[i])
-        summary.noise_sigma[i] = PointNoiseSigma(options_, planes[i].point_robot, thickness[i]);
+      if (!associated[i]) continue;
+      summary.noise_sigma[i] = PointNoiseSigma(options_, planes[i].point_robot, thickness[i]);
     }
     summary.planes = std::move(planes);
     summary.associated = std::move(associated);
