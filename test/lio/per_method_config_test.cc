@@ -122,19 +122,23 @@ TEST(PerMethodConfig, PoseCovarianceLidarFloorIsPerMethodAndNonNegative) {
   const OdometryConfig v =
       LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/sensors/vlp16.yaml");
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_growth, 1.0);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.00065);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_m, 0.001);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_rad, 0.0003);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).pose_covariance_map_sigma_m, 0.0);
   EXPECT_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 0.0);
   // The model's misfit (misfit_covariance.h): Singer-LIO's on the VLP-16, off by default.
   EXPECT_TRUE(v.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
   EXPECT_FALSE(v.ForMethod(LioMethod::kImuInput).pose_covariance_misfit);
   EXPECT_TRUE(c.ForMethod(LioMethod::kSingerLio).pose_covariance_misfit);
   EXPECT_FALSE(OdometryConfig().pose_covariance_misfit);
+  // The Cauchy scale 0.05 is both methods' (vlp16.yaml's per_method); lidar_only keeps the base's.
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.loss_scale, 0.05);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.loss_scale, 0.05);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kLidarOnly).frontend.loss_scale, 0.2);
   // The line-neighbourhood plane fit is both methods' (vlp16.yaml's lidar_frontend).
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kSingerLio).frontend.line_neighbourhood_ratio, 0.3);
   EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).frontend.line_neighbourhood_ratio, 0.3);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.0012);
-  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_m, 0.008);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_rad, 0.0005);
+  EXPECT_DOUBLE_EQ(v.ForMethod(LioMethod::kImuInput).pose_covariance_map_sigma_m, 0.002);
   const OdometryConfig nc =
       LoadOdometryConfig(ctlio::testing::SourceDir() + "/data/newer_college_lio.yaml");
   EXPECT_DOUBLE_EQ(nc.ForMethod(LioMethod::kImuInput).pose_covariance_map_growth, 1.0);
