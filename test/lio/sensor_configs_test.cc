@@ -3,7 +3,8 @@
 // the driver's accelerometer unit, and an extrinsic exactly where the device fixes one (Ouster,
 // Livox): never for an external IMU (Velodyne, Hesai), whose recording's /tf_static a config
 // extrinsic would silently override; where a file weighs planes by their thickness, foliage
-// weighs less than a wall.
+// weighs less than a wall; each estimator's Cauchy scale is its sensor's, set without losing the
+// base's per-method budget.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -85,6 +86,35 @@ TEST(SensorConfigs, ThicknessWeightTellsFoliageFromAWall) {
     EXPECT_LT(sigma / PointNoiseSigma(o, q, t_crown), 0.5 * sigma / PointNoiseSigma(o, q, t_wall));
   }
   EXPECT_GE(files_with_it, 1);
+}
+
+// Each file's per-method Cauchy scale (chosen per sensor and estimator on the tuning cells,
+// docs/experiments/scoreboard.md, "Every sensor's Cauchy scale") merges into base.yaml's
+// per_method block: the baseline keeps its registration budget and cubic IMU reading, and the
+// lidar-only registrations keep the file's own scale.
+TEST(SensorConfigs, EachEstimatorHasItsSensorsCauchyScale) {
+  struct Scale {
+    const char* sensor;
+    double singer_lio, imu_input, lidar_only;
+  };
+  const Scale scales[] = {{"os0_128", 0.1, 0.1, 0.2},    {"os1_64", 0.05, 0.05, 0.2},
+                          {"os1_128", 0.05, 0.1, 0.2},   {"vlp16", 0.05, 0.05, 0.2},
+                          {"hdl32e", 0.05, 0.05, 0.1},   {"pandar_xt32", 0.1, 0.05, 0.2},
+                          {"mid360", 0.05, 0.1, 0.2},    {"avia", 0.05, 0.05, 0.2}};
+  ASSERT_EQ(std::size(scales), sim::SensorModels().size());
+  for (const Scale& s : scales) {
+    SCOPED_TRACE(s.sensor);
+    const OdometryConfig c = LoadOdometryConfig(kDir + s.sensor + ".yaml");
+    EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kSingerLio).frontend.loss_scale, s.singer_lio);
+    EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kImuInput).frontend.loss_scale, s.imu_input);
+    EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kLidarOnly).frontend.loss_scale, s.lidar_only);
+    EXPECT_DOUBLE_EQ(c.ForMethod(LioMethod::kLidarGyro).frontend.loss_scale, s.lidar_only);
+    const OdometryConfig b = c.ForMethod(LioMethod::kImuInput);
+    EXPECT_EQ(b.frontend.max_iterations, 4);
+    EXPECT_EQ(b.frontend.max_keypoints, 800);
+    EXPECT_EQ(b.input_substeps, 4);
+    EXPECT_EQ(b.input_interpolation, "cubic");
+  }
 }
 
 }  // namespace
