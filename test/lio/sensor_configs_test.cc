@@ -97,10 +97,10 @@ TEST(SensorConfigs, EachEstimatorHasItsSensorsCauchyScale) {
     const char* sensor;
     double singer_lio, imu_input, lidar_only;
   };
-  const Scale scales[] = {{"os0_128", 0.1, 0.1, 0.2},    {"os1_64", 0.05, 0.05, 0.2},
-                          {"os1_128", 0.05, 0.1, 0.2},   {"vlp16", 0.05, 0.05, 0.2},
-                          {"hdl32e", 0.05, 0.05, 0.1},   {"pandar_xt32", 0.1, 0.05, 0.2},
-                          {"mid360", 0.05, 0.1, 0.2},    {"avia", 0.05, 0.05, 0.2}};
+  const Scale scales[] = {{"os0_128", 0.1, 0.1, 0.2},  {"os1_64", 0.05, 0.05, 0.2},
+                          {"os1_128", 0.05, 0.1, 0.2}, {"vlp16", 0.05, 0.05, 0.2},
+                          {"hdl32e", 0.05, 0.05, 0.1}, {"pandar_xt32", 0.1, 0.05, 0.2},
+                          {"mid360", 0.05, 0.1, 0.2},  {"avia", 0.05, 0.05, 0.2}};
   ASSERT_EQ(std::size(scales), sim::SensorModels().size());
   for (const Scale& s : scales) {
     SCOPED_TRACE(s.sensor);
