@@ -100,7 +100,8 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
   f << "# t_s status keypoints associations imu_residuals rounds solver_iterations final_cost "
        "ms ms_preprocess ms_associate ms_solve ms_map ms_marginalize cpu_ms x y z imu_rejected "
        "points_dropped degen_t_min degen_r_min degen_dirs degen_dir degen_lidar_info "
-       "degen_prior_info accel_chi2 accel_dof gyro_chi2 gyro_dof correction_m message\n";
+       "degen_prior_info accel_chi2 accel_dof gyro_chi2 gyro_dof correction_m correction_rad "
+       "message\n";
   f << std::setprecision(12);
   for (size_t i = 0; i < run.scans.size(); ++i) {
     const lio::ScanResult& r = run.scans[i];
@@ -124,7 +125,8 @@ void WriteScanLog(const std::string& path, const RunSummary& run) {
       f << "- - - - - - ";
     }
     f << r.accel_chi2 << ' ' << r.accel_dof << ' ' << r.gyro_chi2 << ' ' << r.gyro_dof << ' '
-      << r.correction_m << ' ' << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
+      << r.correction_m << ' ' << r.correction_rad << ' '
+      << (r.message.empty() ? "-" : "\"" + r.message + "\"") << '\n';
   }
   io::CloseChecked(f, path);
 }

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "ctlio/factors/priors/pose_prior.h"
@@ -74,33 +76,80 @@ TEST(ScanWithoutImu, AScanWithImuIsLeftAlone) {
   EXPECT_EQ(window.State(2)[0], 9.0);
 }
 
+// `result` with a correction of `m` metres and `rad` radians from its prediction.
+ScanResult Corrected(double m, double rad, ScanStatus status = ScanStatus::kImuGap) {
+  ScanResult r;
+  r.status = status;
+  r.correction_m = m;
+  r.correction_rad = rad;
+  if (status == ScanStatus::kImuGap) r.message = "IMU gap of 2 s";
+  return r;
+}
+
+LidarFrontendOptions Limits(double m, double rad) {
+  LidarFrontendOptions o;
+  o.max_correction_without_imu = m;
+  o.max_rotation_correction_without_imu = rad;
+  return o;
+}
+
 TEST(ScanWithoutImu, RejectsACorrectionAboveTheLimitOnlyInAnOutageOfAnImuMethod) {
   SlidingWindow window;
   window.AddPoseState(2, SE3());
   ScanWithoutImu scan;
   scan.Begin(true, {2}, window);
-  ScanResult result;
-  result.status = ScanStatus::kImuGap;
-  result.message = "IMU gap of 2 s";
-  EXPECT_FALSE(scan.RejectsCorrection(true, 0.30, 0.30, &result));   // the limit itself passes
-  EXPECT_FALSE(scan.RejectsCorrection(true, 0.31, 0.0, &result));    // 0 = off
-  EXPECT_FALSE(scan.RejectsCorrection(false, 0.31, 0.30, &result));  // lidar_only
+  ScanResult result = Corrected(0.30, 0.0);
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.30, 0.0), &result));  // the limit passes
+  result.correction_m = 0.31;
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.0, 0.0), &result));    // 0 = off
+  EXPECT_FALSE(scan.RejectsCorrection(false, Limits(0.30, 0.0), &result));  // lidar_only
   EXPECT_EQ(result.status, ScanStatus::kImuGap);
-  ASSERT_TRUE(scan.RejectsCorrection(true, 0.31, 0.30, &result));
+  ASSERT_TRUE(scan.RejectsCorrection(true, Limits(0.30, 0.0), &result));
   EXPECT_EQ(result.status, ScanStatus::kDegenerate);
   EXPECT_NE(result.message.find("0.31 m from the prediction"), std::string::npos) << result.message;
   EXPECT_NE(result.message.find("lidar_frontend.max_correction_without_imu"), std::string::npos);
   EXPECT_NE(result.message.find("IMU gap of 2 s"), std::string::npos);  // the gap's reason kept
 
-  ScanResult failed;
-  failed.status = ScanStatus::kFailed;  // a divergence is reported as such, not as a rejection
-  EXPECT_FALSE(scan.RejectsCorrection(true, 9.0, 0.30, &failed));
+  ScanResult failed = Corrected(9.0, 1.0, ScanStatus::kFailed);
+  // A divergence is reported as such, not as a rejection.
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.30, 0.1), &failed));
   EXPECT_EQ(failed.status, ScanStatus::kFailed);
 
   scan.Begin(false, {2}, window);  // a scan with IMU samples
-  ScanResult measured;
-  EXPECT_FALSE(scan.RejectsCorrection(true, 9.0, 0.30, &measured));
+  ScanResult measured = Corrected(9.0, 1.0, ScanStatus::kOk);
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.30, 0.1), &measured));
   EXPECT_EQ(measured.status, ScanStatus::kOk);
+}
+
+// A registration that turns an outage scan further than the rotation limit is rejected though
+// it moved the pose less than the translation limit (the Pandar XT-32 box medium run whose
+// 17° turn at 0.2 m the translation limit let through); each limit alone, 0 = off.
+TEST(ScanWithoutImu, RejectsARotationAboveItsLimitWhateverTheTranslation) {
+  SlidingWindow window;
+  window.AddPoseState(2, SE3());
+  ScanWithoutImu scan;
+  scan.Begin(true, {2}, window);
+  const double turn = 17.0 * M_PI / 180.0;
+  ScanResult kept = Corrected(0.2, 0.1);
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.5, 0.1), &kept));  // the limit itself passes
+  ScanResult off = Corrected(0.2, turn);
+  EXPECT_FALSE(scan.RejectsCorrection(true, Limits(0.5, 0.0), &off));
+  EXPECT_FALSE(scan.RejectsCorrection(false, Limits(0.5, 0.1), &off));  // lidar_only
+  ScanResult turned = Corrected(0.2, turn);
+  ASSERT_TRUE(scan.RejectsCorrection(true, Limits(0.5, 0.1), &turned));
+  EXPECT_EQ(turned.status, ScanStatus::kDegenerate);
+  EXPECT_NE(turned.message.find("turned the pose 0.296"), std::string::npos) << turned.message;
+  EXPECT_NE(turned.message.find("lidar_frontend.max_rotation_correction_without_imu"),
+            std::string::npos);
+  ScanResult rotation_off = Corrected(0.6, 0.0);  // the translation limit alone still holds
+  EXPECT_TRUE(scan.RejectsCorrection(true, Limits(0.5, 0.0), &rotation_off));
+  ScanResult nan = Corrected(0.1, std::nan(""));  // not a finite turn: rejected
+  EXPECT_TRUE(scan.RejectsCorrection(true, Limits(0.5, 0.1), &nan));
+  // The limit is an angle: in [0, π].
+  EXPECT_NO_THROW(Limits(0.5, M_PI).Validate());
+  for (const double bad : {-0.1, 4.0, std::nan("")}) {
+    EXPECT_THROW(Limits(0.5, bad).Validate(), std::invalid_argument) << bad;
+  }
 }
 
 }  // namespace

@@ -57,6 +57,8 @@ void LidarFrontendOptions::Validate() const {
           "solver_iterations_without_imu must be in [0, 1000] (0 = solver_iterations)");
   require(max_correction_without_imu >= 0.0 && max_correction_without_imu <= 1000.0,
           "max_correction_without_imu must be in [0, 1000] m (0 = off)");
+  require(max_rotation_correction_without_imu >= 0.0 && max_rotation_correction_without_imu <= M_PI,
+          "max_rotation_correction_without_imu must be in [0, pi] rad (0 = off)");
   require(high_speed >= 0.0 && high_speed <= 1000.0,
           "high_speed must be in [0, 1000] m/s (0 = off)");
   require(max_iterations_high_speed >= 0 && max_iterations_high_speed <= 100,
@@ -115,6 +117,7 @@ LidarFrontendOptions LidarFrontendOptionsFromYaml(const YAML::Node& node, const 
       {"max_iterations_without_imu", SetFromYaml(&o.max_iterations_without_imu)},
       {"solver_iterations_without_imu", SetFromYaml(&o.solver_iterations_without_imu)},
       {"max_correction_without_imu", SetFromYaml(&o.max_correction_without_imu)},
+      {"max_rotation_correction_without_imu", SetFromYaml(&o.max_rotation_correction_without_imu)},
       {"high_speed", SetFromYaml(&o.high_speed)},
       {"max_iterations_high_speed", SetFromYaml(&o.max_iterations_high_speed)},
       {"solver_iterations_high_speed", SetFromYaml(&o.solver_iterations_high_speed)},

@@ -250,12 +250,12 @@ void LioOdometry::Process(const PreparedScan& scan, ScanResult* result) {
   const size_t kept = std::exchange(map_points_kept_, 0), map_size = map_size_;
   const SE3 T_mr = estimator_->NewestPose();
   result->correction_m = (T_mr.translation() - predicted_mr.translation()).norm();
+  result->correction_rad = so3::Log(predicted_mr.rotation().transpose() * T_mr.rotation()).norm();
   const bool plausible =
       CheckPlausibleJump((T_mr.translation() - estimator_->PreviousPose().translation()).norm(),
                          T_mr.translation().allFinite(), config_.max_scan_translation, result);
-  const bool rejected = plausible && without_imu_.RejectsCorrection(
-                                         uses_imu(), result->correction_m,
-                                         config_.frontend.max_correction_without_imu, result);
+  const bool rejected =
+      plausible && without_imu_.RejectsCorrection(uses_imu(), config_.frontend, result);
   const bool restored = (!plausible || rejected) && without_imu_.Restore(registered, &window_);
   if (plausible && !rejected) {
     estimator_->MapPoints(scan, &map_points_);

@@ -16,14 +16,27 @@ void ScanWithoutImu::Begin(bool applies, const std::vector<StateId>& keys,
   for (const StateId id : keys) start_.emplace_back(id, window.Vector(id));
 }
 
-bool ScanWithoutImu::RejectsCorrection(bool uses_imu, double correction, double limit,
+bool ScanWithoutImu::RejectsCorrection(bool uses_imu, const LidarFrontendOptions& options,
                                        ScanResult* result) const {
-  if (!active() || !uses_imu || limit <= 0.0 || !(correction > limit)) return false;
+  if (!active() || !uses_imu) return false;
   if (result->status == ScanStatus::kFailed) return false;  // already rejected as a divergence
+  const double limit_m = options.max_correction_without_imu;
+  const double limit_rad = options.max_rotation_correction_without_imu;
+  // NaN corrections are rejected: !(x <= limit).
+  const bool moved = limit_m > 0.0 && !(result->correction_m <= limit_m);
+  const bool turned = limit_rad > 0.0 && !(result->correction_rad <= limit_rad);
+  if (!moved && !turned) return false;
   std::ostringstream m;
-  m << "registration moved the pose " << correction << " m from the prediction (limit " << limit
-    << " m, lidar_frontend.max_correction_without_imu) with no IMU sample in the scan: rejected, "
-       "the prediction is kept and the scan's points stay out of the map";
+  if (moved) {
+    m << "registration moved the pose " << result->correction_m << " m from the prediction (limit "
+      << limit_m << " m, lidar_frontend.max_correction_without_imu)";
+  } else {
+    m << "registration turned the pose " << result->correction_rad
+      << " rad from the prediction (limit " << limit_rad
+      << " rad, lidar_frontend.max_rotation_correction_without_imu)";
+  }
+  m << " with no IMU sample in the scan: rejected, the prediction is kept and the scan's points "
+       "stay out of the map";
   if (!result->message.empty()) m << "; " << result->message;
   result->status = ScanStatus::kDegenerate;
   result->message = m.str();

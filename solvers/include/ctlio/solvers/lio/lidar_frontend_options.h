@@ -101,6 +101,11 @@ struct LidarFrontendOptions {
   // also has the limit's cost on an unseen run). Applies to Singer-LIO and lidar_gyro in an
   // outage, not to lidar_only, whose every scan has no IMU.
   double max_correction_without_imu = 0.0;  // m
+  // The same for the rotation [rad] of the pose away from the prediction (0 = off): a
+  // registration can turn an outage scan onto a wrong minimum while moving it less than the
+  // translation limit (pandar_xt32 box medium 4, 2 s outage: 17° in one scan at 0.2 m, the run
+  // 62° off; docs/experiments/imu-dropout.md, "Rejecting a registration that turns").
+  double max_rotation_correction_without_imu = 0.0;  // rad
   // The budget of a scan predicted at high speed (registration_budget.h): a scan whose predicted
   // mean speed over its interval is at least high_speed [m/s] gets max_iterations_high_speed ×
   // solver_iterations_high_speed (0 = max_iterations / solver_iterations). At 12–14 m/s the

@@ -330,6 +330,7 @@ struct ScanResult {
   // Translation [m] of the estimate away from the prediction it started from (the GP's
   // extrapolation or the baseline's preintegration); 0 for the initialising scan.
   double correction_m = 0.0;
+  double correction_rad = 0.0;  // the rotation angle of the same correction
   int solver_iterations = 0;
   double final_cost = 0.0;
   // Whitened χ² (no robust loss) of the IMU terms this scan added, at its final estimate, and

@@ -11,7 +11,8 @@
 //   prediction instead of from the diverged pose, which no later scan recovers from (lidar_only,
 //   vlp16 park walk 100: 95 failed scans of 100 after a jump at its third scan);
 // - in an IMU outage of an IMU method, is rejected the same way when the lidar moved it further
-//   from the prediction than LidarFrontendOptions::max_correction_without_imu (RejectsCorrection).
+//   from the prediction than LidarFrontendOptions::max_correction_without_imu, or turned it further
+//   than max_rotation_correction_without_imu (RejectsCorrection).
 // Scans with IMU samples are untouched: runs without an outage are the same bit for bit.
 #pragma once
 
@@ -38,12 +39,15 @@ class ScanWithoutImu {
   // Whether the scan begun last is one.
   bool active() const { return !start_.empty(); }
 
-  // Whether the scan begun last, of a method that `uses_imu`, is rejected for a correction of
-  // `correction` m from its prediction above `limit` (0 = off): then `result` is marked degenerate
-  // with the reason, and the caller restores it (Restore) and leaves its points out of the map.
+  // Whether the scan begun last, of a method that `uses_imu`, is rejected for a correction from
+  // its prediction (result->correction_m, correction_rad) above `options`' limits
+  // (max_correction_without_imu, max_rotation_correction_without_imu; 0 = off): then `result` is
+  // marked degenerate with the reason, and the caller restores it (Restore) and leaves its points
+  // out of the map.
   // Never for lidar_only (uses_imu false): every one of its scans is one, and its prediction never
   // had the IMU's motion behind it (not measured for it: docs/experiments/imu-dropout.md).
-  bool RejectsCorrection(bool uses_imu, double correction, double limit, ScanResult* result) const;
+  bool RejectsCorrection(bool uses_imu, const LidarFrontendOptions& options,
+                         ScanResult* result) const;
 
   // After an implausible estimate: when active(), removes the scan's lidar residuals and restores
   // the starting values; returns whether it did.
